@@ -1,0 +1,177 @@
+// check_invariants(): structural checks of a flattened BVH (the contract is in bvh.h and
+// kernels/shared/bvh_layout.h). Walks the tree from node 0 and reports the first violation.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bvh.h"
+
+namespace wp::bvh {
+namespace {
+
+struct ChildBox {
+  float lo[3], hi[3];
+};
+
+ChildBox child_box(const dev::BvhNode& n, int slot) {
+  const dev::float4& xy = slot == 0 ? n.c0_xy : n.c1_xy;
+  const float loz = slot == 0 ? n.c01_z.x : n.c01_z.z;
+  const float hiz = slot == 0 ? n.c01_z.y : n.c01_z.w;
+  return ChildBox{{xy.x, xy.z, loz}, {xy.y, xy.w, hiz}};
+}
+
+bool inside(const ChildBox& c, const ChildBox& p) {
+  for (int k = 0; k < 3; ++k)
+    if (!(c.lo[k] >= p.lo[k] && c.hi[k] <= p.hi[k] && c.lo[k] <= c.hi[k])) return false;
+  return true;
+}
+
+std::uint32_t bits(float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+class Checker {
+ public:
+  Checker(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits)
+      : bvh_(bvh), triangle_count_(triangle_count), splits_(spatial_splits) {
+    const float extent = std::max({std::fabs(bvh.lo.x), std::fabs(bvh.lo.y), std::fabs(bvh.lo.z),
+                                   std::fabs(bvh.hi.x), std::fabs(bvh.hi.y), std::fabs(bvh.hi.z)});
+    // v1 = v0 + e1 is rebuilt with a rounding error of a few ulps of the coordinates.
+    tolerance_ = 1e-6f * extent + 1e-30f;
+  }
+
+  std::string run() {
+    if (bvh_.nodes.empty()) return "no nodes (node 0 must be the root)";
+    visited_.assign(bvh_.nodes.size(), false);
+    slot_owner_.assign(bvh_.triangles.size(), false);
+    refs_.assign(triangle_count_, 0);
+    const ChildBox scene{{bvh_.lo.x, bvh_.lo.y, bvh_.lo.z}, {bvh_.hi.x, bvh_.hi.y, bvh_.hi.z}};
+    std::vector<Pending> todo{{0, scene, 1}};
+    visited_[0] = true;
+    while (!todo.empty() && error_.empty()) {
+      const Pending p = todo.back();
+      todo.pop_back();
+      for (int slot = 0; slot < 2 && error_.empty(); ++slot) child(p, slot, todo);
+    }
+    if (error_.empty()) finish();
+    return error_;
+  }
+
+ private:
+  struct Pending {
+    std::int32_t node;
+    ChildBox box;
+    int depth;
+  };
+
+  void fail(std::int32_t node, int slot, const std::string& what) {
+    std::ostringstream s;
+    s << "node " << node << " child " << slot << ": " << what;
+    error_ = s.str();
+  }
+
+  void child(const Pending& p, int slot, std::vector<Pending>& todo) {
+    const dev::BvhNode& n = bvh_.nodes[static_cast<std::size_t>(p.node)];
+    const std::int32_t link = slot == 0 ? n.link.x : n.link.y;
+    const std::int32_t count = slot == 0 ? n.link.z : n.link.w;
+    const ChildBox box = child_box(n, slot);
+    if (link < 0 && count == 0) return empty_child(p, slot, box);
+    if (!inside(box, p.box)) return fail(p.node, slot, "box not inside its parent's");
+    if (link < 0) return leaf(p.node, slot, ~link, count, box);
+    if (count != 0) return fail(p.node, slot, "inner child with a triangle count");
+    if (static_cast<std::size_t>(link) >= bvh_.nodes.size())
+      return fail(p.node, slot, "node index out of range");
+    if (visited_[static_cast<std::size_t>(link)]) return fail(p.node, slot, "node reached twice");
+    const bool first_inner = slot == 0 || n.link.x < 0;
+    if (first_inner && link != p.node + 1) return fail(p.node, slot, "not in depth-first preorder");
+    if (p.depth + 1 > WP_BVH_MAX_DEPTH) return fail(p.node, slot, "deeper than WP_BVH_MAX_DEPTH");
+    visited_[static_cast<std::size_t>(link)] = true;
+    todo.push_back({link, box, p.depth + 1});
+  }
+
+  // Only the root of a single-leaf scene has one: child 1, count 0, lo > hi.
+  void empty_child(const Pending& p, int slot, const ChildBox& box) {
+    const dev::BvhNode& n = bvh_.nodes[static_cast<std::size_t>(p.node)];
+    if (p.node != 0 || slot != 1 || n.link.x >= 0)
+      return fail(p.node, slot, "empty child outside a single-leaf root");
+    for (int k = 0; k < 3; ++k)
+      if (!(box.lo[k] > box.hi[k])) return fail(p.node, slot, "empty child with a non-empty box");
+  }
+
+  void leaf(std::int32_t node, int slot, std::int32_t first, std::int32_t count,
+            const ChildBox& box) {
+    if (count < 1 || count > WP_BVH_MAX_LEAF_SIZE)
+      return fail(node, slot, "leaf size " + std::to_string(count));
+    const auto begin = static_cast<std::size_t>(first);
+    if (begin + static_cast<std::size_t>(count) > bvh_.triangles.size())
+      return fail(node, slot, "triangle range out of bounds");
+    for (std::size_t i = begin; i < begin + static_cast<std::size_t>(count); ++i) {
+      if (slot_owner_[i]) return fail(node, slot, "triangle slot in two leaves");
+      slot_owner_[i] = true;
+      const dev::IsectTri& t = bvh_.triangles[i];
+      const std::uint32_t index = bits(t.v0.w);
+      if (index >= triangle_count_) return fail(node, slot, "triangle index out of range");
+      if (bits(t.e2.w) != 0) return fail(node, slot, "e2.w not 0");
+      refs_[index]++;
+      if (!triangle_fits(t, box))
+        return fail(node, slot, "triangle " + std::to_string(index) + " outside its leaf box");
+    }
+  }
+
+  // Without spatial splits the whole triangle lies in the leaf box; with them its bounds must at
+  // least overlap the box (the box holds a clipped piece).
+  bool triangle_fits(const dev::IsectTri& t, const ChildBox& box) const {
+    const float v0[3] = {t.v0.x, t.v0.y, t.v0.z};
+    const float e1[3] = {t.e1.x, t.e1.y, t.e1.z};
+    const float e2[3] = {t.e2.x, t.e2.y, t.e2.z};
+    for (int k = 0; k < 3; ++k) {
+      const float lo = std::min({v0[k], v0[k] + e1[k], v0[k] + e2[k]});
+      const float hi = std::max({v0[k], v0[k] + e1[k], v0[k] + e2[k]});
+      const bool ok = splits_ ? hi >= box.lo[k] - tolerance_ && lo <= box.hi[k] + tolerance_
+                              : lo >= box.lo[k] - tolerance_ && hi <= box.hi[k] + tolerance_;
+      if (!ok) return false;
+    }
+    return true;
+  }
+
+  void finish() {
+    const auto unvisited = std::find(visited_.begin(), visited_.end(), false);
+    if (unvisited != visited_.end()) {
+      error_ = "node " + std::to_string(unvisited - visited_.begin()) + " unreachable";
+      return;
+    }
+    const auto unused = std::find(slot_owner_.begin(), slot_owner_.end(), false);
+    if (unused != slot_owner_.end()) {
+      error_ = "triangle slot " + std::to_string(unused - slot_owner_.begin()) + " in no leaf";
+      return;
+    }
+    for (std::size_t i = 0; i < refs_.size(); ++i) {
+      if (refs_[i] == 0 || (!splits_ && refs_[i] != 1)) {
+        error_ =
+            "triangle " + std::to_string(i) + " referenced " + std::to_string(refs_[i]) + " times";
+        return;
+      }
+    }
+  }
+
+  const Bvh& bvh_;
+  std::size_t triangle_count_;
+  bool splits_;
+  float tolerance_ = 0;
+  std::vector<bool> visited_, slot_owner_;
+  std::vector<std::uint32_t> refs_;
+  std::string error_;
+};
+
+}  // namespace
+
+std::string check_invariants(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits) {
+  return Checker(bvh, triangle_count, spatial_splits).run();
+}
+
+}  // namespace wp::bvh

@@ -1,0 +1,50 @@
+/* The flattened BVH as the device traverses it (shared by host and OpenCL C).
+ *
+ * Binary BVH, both child boxes stored in the parent (64 bytes per node), nodes in depth-first
+ * order with node 0 the root. A child reference `link.x`/`link.y` is
+ *   >= 0 : index of an inner node,
+ *   <  0 : a leaf; ~ref is the index of its first triangle in the reordered triangle array and
+ *          link.z (child 0) / link.w (child 1) its triangle count (1..WP_BVH_MAX_LEAF_SIZE).
+ * An empty child (only in a root whose scene is a single leaf) is a leaf with count 0: rays may
+ * enter its (inverted, lo > hi) box, but it holds no triangle to test.
+ *
+ * Triangles are reordered so that every leaf's triangles are contiguous. Each is stored ready for
+ * the Moller-Trumbore test: v0, e1 = v1 - v0, e2 = v2 - v0, world space. The spare w lanes carry
+ *   v0.w : the index of the triangle in the scene (as_float of a uint),
+ *   e1.w : WP_TRI_* flags (as_float of a uint).
+ * The front face is counter-clockwise (glTF): the geometric normal cross(e1, e2) points to it.
+ */
+#ifndef WP_SHARED_BVH_LAYOUT_H
+#define WP_SHARED_BVH_LAYOUT_H
+
+#include "compat.h"
+
+/* The traversal kernels keep a private stack of this many node references. The builder limits
+ * the tree depth so that depth-first traversal (pushing at most one node per level) never needs
+ * more: Embree's maxDepth is set to WP_BVH_MAX_DEPTH. */
+#define WP_BVH_MAX_DEPTH 48
+#define WP_BVH_STACK_SIZE WP_BVH_MAX_DEPTH
+/* Largest leaf the builder makes; the link.z/link.w counts never exceed it. */
+#define WP_BVH_MAX_LEAF_SIZE 8
+
+/* Triangle flags (IsectTri.e1.w). */
+#define WP_TRI_CULL_BACKFACE 1u /* single-sided material: back faces are not there for any ray */
+
+WP_DEV_BEGIN
+
+typedef struct BvhNode {
+  float4 c0_xy; /* child 0 box: lo.x, hi.x, lo.y, hi.y */
+  float4 c1_xy; /* child 1 box: lo.x, hi.x, lo.y, hi.y */
+  float4 c01_z; /* lo.z of child 0, hi.z of child 0, lo.z of child 1, hi.z of child 1 */
+  int4 link;    /* x, y: child references; z, w: leaf triangle counts (0 for inner children) */
+} BvhNode;
+
+typedef struct IsectTri {
+  float4 v0; /* xyz: vertex 0; w: scene triangle index (bits of a uint) */
+  float4 e1; /* xyz: v1 - v0;  w: WP_TRI_* flags (bits of a uint) */
+  float4 e2; /* xyz: v2 - v0;  w: unused (0) */
+} IsectTri;
+
+WP_DEV_END
+
+#endif /* WP_SHARED_BVH_LAYOUT_H */
