@@ -1,0 +1,93 @@
+// The host's scene: flat world-space arrays, everything the renderer needs and nothing of glTF's
+// structure. Produced by the glTF loader (gltf_loader.h), consumed by the BVH builder and the
+// device upload.
+//
+// Units and conventions (fixed for the whole project):
+// - Lengths are in scene units (glTF: metres); the renderer never assumes a scale.
+// - Colours are linear RGB. Emission is radiance: emissiveFactor x emissive_strength.
+// - A point/spot light's intensity (glTF candela) is read as radiant intensity in W/sr of the
+//   linear RGB image, no 683 lm/W factor: it gives irradiance I cos(theta) / d^2 at distance d.
+//   A directional light's intensity (glTF lux) is irradiance in W/m^2 on a surface facing it.
+// - Triangles wind counter-clockwise seen from their front (glTF); the loader keeps that true under
+//   mirroring transforms (negative determinant).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace wp {
+
+enum class AlphaMode : std::uint8_t { kOpaque, kMask, kBlend };
+
+struct Material {
+  std::string name;
+  glm::vec4 base_color{1.0f};  // baseColorFactor, linear RGB + alpha
+  float metallic = 1.0f;       // glTF defaults
+  float roughness = 1.0f;
+  glm::vec3 emission{0.0f};  // radiance: emissiveFactor x KHR_materials_emissive_strength
+  bool double_sided = false;
+  AlphaMode alpha_mode = AlphaMode::kOpaque;
+  float alpha_cutoff = 0.5f;
+  float ior = 1.5f;           // KHR_materials_ior
+  float transmission = 0.0f;  // KHR_materials_transmission factor
+};
+
+enum class LightType : std::uint8_t { kPoint, kSpot, kDirectional };
+
+struct PunctualLight {
+  std::string name;
+  LightType type = LightType::kPoint;
+  glm::vec3 position{0.0f};                // world space (point, spot)
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // unit, the direction light travels (spot, directional)
+  glm::vec3 intensity{1.0f};  // colour x intensity: W/sr (point, spot) or W/m^2 (directional)
+  float range = 0.0f;         // 0: infinite
+  float inner_cone = 0.0f;    // radians (spot)
+  float outer_cone = 0.7853981633974483f;  // radians (spot), glTF default pi/4
+};
+
+enum class CameraType : std::uint8_t { kPerspective, kOrthographic };
+
+struct Camera {
+  std::string name;
+  CameraType type = CameraType::kPerspective;
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit view direction (the node's -Z)
+  glm::vec3 up{0.0f, 1.0f, 0.0f};        // unit, orthogonal to forward (the node's +Y)
+  float yfov = 0.8f;                     // perspective: vertical field of view, radians
+  float xmag = 1.0f;                     // orthographic: half width of the view, scene units
+  float ymag = 1.0f;                     // orthographic: half height
+  float znear = 0.0f;  // distance to the near plane along forward; nothing closer is seen
+};
+
+struct Scene {
+  std::string source;  // file the scene came from
+
+  // Vertices (world space). normals are unit; uv0 is TEXCOORD_0 or (0,0); color0 is COLOR_0 as
+  // linear RGBA or (1,1,1,1).
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uv0;
+  std::vector<glm::vec4> color0;
+
+  // Triangles: three vertex indices each (counter-clockwise front), and a material index.
+  std::vector<std::uint32_t> indices;            // 3 x triangle_count()
+  std::vector<std::uint32_t> triangle_material;  // triangle_count()
+
+  std::vector<Material> materials;  // never empty: the loader adds glTF's default material if used
+  std::vector<PunctualLight> lights;
+  std::vector<Camera> cameras;  // in node order (depth-first over the default scene)
+
+  glm::vec3 bounds_lo{0.0f}, bounds_hi{0.0f};
+
+  std::vector<std::string> warnings;  // one line each: skipped primitives, unsupported extensions
+
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+
+}  // namespace wp

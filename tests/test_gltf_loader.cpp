@@ -1,0 +1,878 @@
+// glTF loader: small synthetic files written by the tests (expected values derived by hand next
+// to each), malformed input, and the shared real-world assets (skipped when absent).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "host/error.h"
+#include "host/gltf_loader.h"
+#include "tests/test_assets.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using glm::vec3;
+
+constexpr float kPi = 3.14159265358979f;
+constexpr int kU8 = 5121, kU16 = 5123, kU32 = 5125, kF32 = 5126, kI8 = 5120, kI16 = 5122;
+
+const fs::path& temp_dir() {
+  static const fs::path dir = [] {
+    // Memory-backed when available: the corruption test writes a few thousand small files.
+    const fs::path root = fs::is_directory("/dev/shm") ? "/dev/shm" : fs::temp_directory_path();
+    fs::path d = root / ("wp_gltf_test_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+class TempCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override { fs::remove_all(temp_dir()); }
+};
+[[maybe_unused]] auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new TempCleanup);
+
+std::string base64(const std::vector<unsigned char>& in) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < in.size(); i += 3) {
+    const unsigned v = (in[i] << 16u) | (i + 1 < in.size() ? in[i + 1] << 8u : 0u) |
+                       (i + 2 < in.size() ? in[i + 2] : 0u);
+    for (int k = 0; k < 4; ++k)
+      out += (i + static_cast<std::size_t>(k) <= in.size()) ? kAlphabet[(v >> (18 - 6 * k)) & 63]
+                                                            : '=';
+  }
+  return out;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const std::string& item : items) s += (s.empty() ? "" : ",") + item;
+  return s;
+}
+
+std::string list(const std::vector<int>& items) {
+  std::vector<std::string> s;
+  for (const int i : items) s.push_back(std::to_string(i));
+  return "[" + join(s) + "]";
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// Assembles a glTF file: one buffer, and JSON arrays that tests fill with raw JSON objects.
+struct Gltf {
+  std::vector<unsigned char> bin;
+  std::vector<std::string> views, accessors, meshes, nodes, materials, cameras, lights;
+  std::vector<int> roots;
+  std::string top;                 // extra top-level members, e.g. "extensionsUsed":[...]
+  std::string scenes = "default";  // or raw members replacing "scene" and "scenes"
+
+  template <typename T>
+  int view(const std::vector<T>& data, std::size_t stride = 0) {
+    while (bin.size() % 4) bin.push_back(0);
+    const std::size_t offset = bin.size(), size = data.size() * sizeof(T);
+    const auto* p = reinterpret_cast<const unsigned char*>(data.data());
+    bin.insert(bin.end(), p, p + size);
+    views.push_back("{\"buffer\":0,\"byteOffset\":" + std::to_string(offset) +
+                    ",\"byteLength\":" + std::to_string(size) +
+                    (stride ? ",\"byteStride\":" + std::to_string(stride) : "") + "}");
+    return static_cast<int>(views.size()) - 1;
+  }
+  int accessor(int view_index, int component_type, std::size_t count, const std::string& type,
+               const std::string& extra = "") {
+    accessors.push_back(
+        "{" +
+        (view_index >= 0 ? "\"bufferView\":" + std::to_string(view_index) + "," : std::string()) +
+        "\"componentType\":" + std::to_string(component_type) +
+        ",\"count\":" + std::to_string(count) + ",\"type\":\"" + type + "\"" + extra + "}");
+    return static_cast<int>(accessors.size()) - 1;
+  }
+  int vec3s(const std::vector<vec3>& v) { return accessor(view(v), kF32, v.size(), "VEC3"); }
+  template <typename T>
+  int indices(const std::vector<T>& v) {
+    const int type = sizeof(T) == 1 ? kU8 : sizeof(T) == 2 ? kU16 : kU32;
+    return accessor(view(v), type, v.size(), "SCALAR");
+  }
+  int mesh(const std::vector<std::string>& primitives) {
+    meshes.push_back("{\"primitives\":[" + join(primitives) + "]}");
+    return static_cast<int>(meshes.size()) - 1;
+  }
+  int node(const std::string& body, bool root = false) {
+    nodes.push_back("{" + body + "}");
+    if (root) roots.push_back(static_cast<int>(nodes.size()) - 1);
+    return static_cast<int>(nodes.size()) - 1;
+  }
+
+  std::string json(bool glb) const {
+    std::string s = "{\"asset\":{\"version\":\"2.0\"}";
+    if (!top.empty()) s += "," + top;
+    s += scenes == "default" ? ",\"scene\":0,\"scenes\":[{\"nodes\":" + list(roots) + "}]"
+         : scenes.empty()    ? ""
+                             : "," + scenes;
+    const auto section = [&](const char* name, const std::vector<std::string>& items) {
+      if (!items.empty()) s += ",\"" + std::string(name) + "\":[" + join(items) + "]";
+    };
+    section("nodes", nodes);
+    section("meshes", meshes);
+    section("materials", materials);
+    section("cameras", cameras);
+    section("accessors", accessors);
+    section("bufferViews", views);
+    s += ",\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) +
+         (glb ? "" : ",\"uri\":\"data:application/octet-stream;base64," + base64(bin) + "\"") +
+         "}]";
+    if (!lights.empty())
+      s += ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[" + join(lights) + "]}}";
+    return s + "}";
+  }
+  std::string write(const std::string& name) const {
+    const std::string path = (temp_dir() / name).string();
+    write_bytes(path, json(false));
+    return path;
+  }
+  std::string glb() const {
+    std::string j = json(true), b(bin.begin(), bin.end());
+    while (j.size() % 4) j += ' ';
+    while (b.size() % 4) b += '\0';
+    const auto u32 = [](std::size_t v) {
+      const auto x = static_cast<std::uint32_t>(v);
+      std::string s(4, '\0');
+      std::memcpy(&s[0], &x, 4);
+      return s;
+    };
+    return "glTF" + u32(2) + u32(12 + 8 + j.size() + 8 + b.size()) + u32(j.size()) + "JSON" + j +
+           u32(b.size()) + std::string("BIN\0", 4) + b;
+  }
+  std::string write_glb(const std::string& name) const {
+    const std::string path = (temp_dir() / name).string();
+    write_bytes(path, glb());
+    return path;
+  }
+};
+
+std::string prim(const std::map<std::string, int>& attributes, int indices = -1, int mode = -1,
+                 int material = -1) {
+  std::vector<std::string> a;
+  for (const auto& [name, index] : attributes)
+    a.push_back("\"" + name + "\":" + std::to_string(index));
+  return "{\"attributes\":{" + join(a) + "}" +
+         (indices >= 0 ? ",\"indices\":" + std::to_string(indices) : "") +
+         (mode >= 0 ? ",\"mode\":" + std::to_string(mode) : "") +
+         (material >= 0 ? ",\"material\":" + std::to_string(material) : "") + "}";
+}
+
+::testing::AssertionResult near(const vec3& a, const vec3& b, float eps = 1e-5f) {
+  if (glm::length(a - b) <= eps) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "(" << a.x << ", " << a.y << ", " << a.z << ") vs ("
+                                       << b.x << ", " << b.y << ", " << b.z << ")";
+}
+
+vec3 corner(const wp::Scene& s, std::size_t t, int c) {
+  return s.positions[s.indices[3 * t + static_cast<std::size_t>(c)]];
+}
+
+vec3 geometric_normal(const wp::Scene& s, std::size_t t) {
+  return glm::normalize(
+      glm::cross(corner(s, t, 1) - corner(s, t, 0), corner(s, t, 2) - corner(s, t, 0)));
+}
+
+// What every loaded scene guarantees (scene.h).
+void check_invariants(const wp::Scene& s) {
+  ASSERT_GT(s.triangle_count(), 0u);
+  ASSERT_EQ(s.indices.size() % 3, 0u);
+  ASSERT_EQ(s.triangle_material.size(), s.triangle_count());
+  ASSERT_EQ(s.normals.size(), s.positions.size());
+  ASSERT_EQ(s.uv0.size(), s.positions.size());
+  ASSERT_EQ(s.color0.size(), s.positions.size());
+  ASSERT_FALSE(s.materials.empty());
+  for (const std::uint32_t i : s.indices) ASSERT_LT(i, s.positions.size());
+  for (const std::uint32_t m : s.triangle_material) ASSERT_LT(m, s.materials.size());
+  for (std::size_t i = 0; i < s.positions.size(); ++i) {
+    const vec3& p = s.positions[i];
+    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    ASSERT_TRUE(glm::all(glm::lessThanEqual(s.bounds_lo, p)) &&
+                glm::all(glm::lessThanEqual(p, s.bounds_hi)));
+    ASSERT_NEAR(glm::length(s.normals[i]), 1.0f, 1e-4f) << "vertex " << i;
+  }
+}
+
+// Expects load_gltf(path) to throw wp::Error whose message names the path and `needle`.
+void expect_error(const std::string& path, const std::string& needle) {
+  try {
+    wp::load_gltf(path);
+    ADD_FAILURE() << path << " loaded; expected an error about " << needle;
+  } catch (const wp::Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find(needle), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+// One triangle (0,0,0), (1,0,0), (0,1,0) in node `body`; with `normals`, one per corner.
+Gltf one_triangle(const std::string& body, const std::vector<vec3>& normals = {}) {
+  Gltf g;
+  std::map<std::string, int> a{{"POSITION", g.vec3s({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}})}};
+  if (!normals.empty()) a["NORMAL"] = g.vec3s(normals);
+  g.mesh({prim(a)});
+  g.node("\"mesh\":0" + std::string(body.empty() ? "" : ",") + body, true);
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Transforms
+
+// Parent: T(1,2,3) R_y(90 deg) S(2); child: matrix scaling x by 3 then translating (0,0,1).
+// R_y(90) maps (x,y,z) to (z,y,-x). Corners: (0,0,0) -> C (0,0,1) -> S (0,0,2) -> R (2,0,0) ->
+// T (3,2,3); (1,0,0) -> (3,0,1) -> (6,0,2) -> (2,0,-6) -> (3,2,-3); (0,1,0) -> (0,1,1) ->
+// (0,2,2) -> (2,2,0) -> (3,4,3). Normals go by R diag(1/3,1,1) (inverse transpose, up to
+// scale): (0,0,1) -> (1,0,0); (1,0,1)/sqrt2 -> R (1/3,0,1) = (1,0,-1/3) -> (3,0,-1)/sqrt10.
+Gltf hierarchy() {
+  Gltf g;
+  const float h = std::sqrt(0.5f);
+  const int pos = g.vec3s({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  const int nrm = g.vec3s({{0, 0, 1}, {h, 0, h}, {0, 0, 1}});
+  g.mesh({prim({{"POSITION", pos}, {"NORMAL", nrm}})});
+  g.node(
+      "\"translation\":[1,2,3],\"rotation\":[0,0.70710678,0,0.70710678],\"scale\":[2,2,2],"
+      "\"children\":[1]",
+      true);
+  g.node("\"mesh\":0,\"matrix\":[3,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1]");
+  return g;
+}
+
+void check_hierarchy(const wp::Scene& s) {
+  check_invariants(s);
+  ASSERT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(near(corner(s, 0, 0), {3, 2, 3}));
+  EXPECT_TRUE(near(corner(s, 0, 1), {3, 2, -3}));
+  EXPECT_TRUE(near(corner(s, 0, 2), {3, 4, 3}));
+  EXPECT_TRUE(near(s.normals[s.indices[0]], {1, 0, 0}));
+  EXPECT_TRUE(near(s.normals[s.indices[1]], vec3(3, 0, -1) / std::sqrt(10.0f)));
+  EXPECT_TRUE(near(geometric_normal(s, 0), {1, 0, 0}));
+  EXPECT_TRUE(near(s.bounds_lo, {3, 2, -3}));
+  EXPECT_TRUE(near(s.bounds_hi, {3, 4, 3}));
+}
+
+TEST(GltfLoader, TrsAndMatrixThroughHierarchy) {
+  const std::string path = hierarchy().write("hierarchy.gltf");
+  const wp::Scene s = wp::load_gltf(path);
+  EXPECT_EQ(s.source, path);
+  EXPECT_TRUE(s.warnings.empty());
+  check_hierarchy(s);
+}
+
+TEST(GltfLoader, GlbMatchesGltf) {
+  const wp::Scene s = wp::load_gltf(hierarchy().write_glb("hierarchy.glb"));
+  check_hierarchy(s);
+  // Content decides the format, not the extension.
+  check_hierarchy(wp::load_gltf(hierarchy().write_glb("binary_named.gltf")));
+}
+
+// Mirroring by scale (-1,1,1): corners (0,0,0), (-1,0,0), (0,1,0); the normal (0,0,1) maps to
+// (0,0,1), and the winding must be swapped for the front (geometric normal) to stay +Z.
+TEST(GltfLoader, MirroredNodeKeepsCounterClockwiseFront) {
+  for (const bool with_normals : {true, false}) {
+    const wp::Scene s = wp::load_gltf(
+        one_triangle("\"scale\":[-1,1,1]",
+                     with_normals ? std::vector<vec3>(3, {0, 0, 1}) : std::vector<vec3>{})
+            .write("mirror.gltf"));
+    check_invariants(s);
+    EXPECT_TRUE(near(geometric_normal(s, 0), {0, 0, 1})) << with_normals;
+    for (int c = 0; c < 3; ++c) EXPECT_TRUE(near(s.normals[s.indices[c]], {0, 0, 1}));
+    EXPECT_TRUE(near(s.bounds_lo, {-1, 0, 0}));
+  }
+  // Two mirrors cancel: diag(-1,1,-1) keeps the winding; both normals become (0,0,-1).
+  Gltf g = one_triangle("\"scale\":[1,1,-1]", std::vector<vec3>(3, {0, 0, 1}));
+  g.node("\"scale\":[-1,1,1],\"children\":[0]");
+  g.roots = {1};
+  const wp::Scene s = wp::load_gltf(g.write("mirror2.gltf"));
+  EXPECT_TRUE(near(corner(s, 0, 1), {-1, 0, 0}));
+  EXPECT_TRUE(near(geometric_normal(s, 0), {0, 0, -1}));
+  EXPECT_TRUE(near(s.normals[s.indices[0]], {0, 0, -1}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Primitives
+
+const std::vector<vec3> kQuad = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+const std::vector<int> kQuadCorners = {0, 1, 2, 0, 2, 3};
+
+void check_quad(const wp::Scene& s) {
+  check_invariants(s);
+  ASSERT_EQ(s.triangle_count(), 2u);
+  for (std::size_t i = 0; i < 6; ++i)
+    EXPECT_TRUE(near(s.positions[s.indices[i]], kQuad[static_cast<std::size_t>(kQuadCorners[i])]))
+        << "corner " << i;
+}
+
+template <typename T>
+void check_indexed_quad(const char* name) {
+  Gltf g;
+  const int pos = g.vec3s(kQuad);
+  const int idx = g.indices(std::vector<T>(kQuadCorners.begin(), kQuadCorners.end()));
+  g.mesh({prim({{"POSITION", pos}}, idx)});
+  g.node("\"mesh\":0", true);
+  const wp::Scene s = wp::load_gltf(g.write(name));
+  check_quad(s);
+  EXPECT_EQ(s.positions.size(), 6u);  // no normals: flat, unshared
+}
+
+TEST(GltfLoader, IndexTypesAndNonIndexed) {
+  check_indexed_quad<std::uint8_t>("u8.gltf");
+  check_indexed_quad<std::uint16_t>("u16.gltf");
+  check_indexed_quad<std::uint32_t>("u32.gltf");
+  Gltf g;
+  std::vector<vec3> corners;
+  for (const int c : kQuadCorners) corners.push_back(kQuad[static_cast<std::size_t>(c)]);
+  g.mesh({prim({{"POSITION", g.vec3s(corners)}})});
+  g.node("\"mesh\":0", true);
+  check_quad(wp::load_gltf(g.write("nonindexed.gltf")));
+}
+
+// Positions and normals interleaved in one view (stride 24), the normals at byteOffset 12.
+TEST(GltfLoader, InterleavedStrideAndOffset) {
+  std::vector<vec3> interleaved;
+  for (const vec3& p : kQuad) interleaved.insert(interleaved.end(), {p, {0, 0, 1}});
+  Gltf g;
+  const int v = g.view(interleaved, 24);
+  const int pos = g.accessor(v, kF32, 4, "VEC3");
+  const int nrm = g.accessor(v, kF32, 4, "VEC3", ",\"byteOffset\":12");
+  g.mesh(
+      {prim({{"POSITION", pos}, {"NORMAL", nrm}}, g.indices<std::uint16_t>({0, 1, 2, 0, 2, 3}))});
+  g.node("\"mesh\":0", true);
+  const wp::Scene s = wp::load_gltf(g.write("interleaved.gltf"));
+  check_quad(s);
+  EXPECT_EQ(s.positions.size(), 4u);  // smooth normals: shared vertices
+  for (const vec3& n : s.normals) EXPECT_TRUE(near(n, {0, 0, 1}));
+}
+
+// Strip v0..v4 = (0,1) (0,0) (1,1) (1,0) (2,1): triangles {v_i, v_i+(1+i%2), v_i+(2-i%2)} =
+// (0,1,2) (1,3,2) (2,3,4), all counter-clockwise seen from +Z. Fan around v0 = (0,0) with
+// v1..v4 = (1,0) (1,1) (0,1) (-1,1): {v_i+1, v_i+2, v_0} = (1,2,0) (2,3,0) (3,4,0).
+TEST(GltfLoader, StripAndFanConversion) {
+  const std::vector<vec3> strip = {{0, 1, 0}, {0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {2, 1, 0}};
+  const std::vector<vec3> fan = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {-1, 1, 0}};
+  const std::vector<int> strip_corners = {0, 1, 2, 1, 3, 2, 2, 3, 4};
+  const std::vector<int> fan_corners = {1, 2, 0, 2, 3, 0, 3, 4, 0};
+  for (const bool is_strip : {true, false}) {
+    const std::vector<vec3>& v = is_strip ? strip : fan;
+    const std::vector<int>& expected = is_strip ? strip_corners : fan_corners;
+    Gltf g;
+    g.mesh({prim({{"POSITION", g.vec3s(v)}}, -1, is_strip ? 5 : 6)});
+    g.node("\"mesh\":0", true);
+    const wp::Scene s = wp::load_gltf(g.write("stripfan.gltf"));
+    check_invariants(s);
+    ASSERT_EQ(s.triangle_count(), 3u);
+    for (std::size_t i = 0; i < 9; ++i)
+      EXPECT_TRUE(near(s.positions[s.indices[i]], v[static_cast<std::size_t>(expected[i])]))
+          << (is_strip ? "strip" : "fan") << " corner " << i;
+    for (std::size_t t = 0; t < 3; ++t) {
+      EXPECT_TRUE(near(geometric_normal(s, t), {0, 0, 1}));
+      EXPECT_TRUE(near(s.normals[s.indices[3 * t]], {0, 0, 1}));
+    }
+  }
+}
+
+// Triangles (0,1,2) in z = 0 (face normal +Z) and (0,2,3) in x = 0 with v3 = (0,0,1) (face
+// normal +X), sharing an edge. Without NORMAL both are flat with unshared vertices; with a
+// zero-length normal at v3 only the second triangle is.
+TEST(GltfLoader, AbsentOrZeroNormalsAreFlat) {
+  const std::vector<vec3> pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (const bool zero_normal : {false, true}) {
+    Gltf g;
+    std::map<std::string, int> a{{"POSITION", g.vec3s(pos)}};
+    if (zero_normal) a["NORMAL"] = g.vec3s({{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 0}});
+    g.mesh({prim(a, g.indices<std::uint8_t>({0, 1, 2, 0, 2, 3}))});
+    g.node("\"mesh\":0", true);
+    const wp::Scene s = wp::load_gltf(g.write("flat.gltf"));
+    check_invariants(s);
+    ASSERT_EQ(s.triangle_count(), 2u);
+    EXPECT_EQ(s.positions.size(), 6u);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(near(s.normals[s.indices[static_cast<std::size_t>(c)]], {0, 0, 1}));
+      EXPECT_TRUE(near(s.normals[s.indices[static_cast<std::size_t>(3 + c)]], {1, 0, 0}));
+    }
+    EXPECT_NE(s.indices[0], s.indices[3]);  // v0 not shared across the crease
+  }
+}
+
+// KHR_mesh_quantization positions (i16 normalized: 32767 -> 1, -32768 -> -1) and normals (i8
+// normalized: 127 -> 1); TEXCOORD_0 u16 normalized; COLOR_0 u8 normalized VEC4 and u16
+// normalized VEC3 (alpha 1).
+TEST(GltfLoader, NormalizedAndQuantizedAttributes) {
+  Gltf g;
+  g.top =
+      "\"extensionsUsed\":[\"KHR_mesh_quantization\"],"
+      "\"extensionsRequired\":[\"KHR_mesh_quantization\"]";
+  const std::string norm = ",\"normalized\":true";
+  const int pos =
+      g.accessor(g.view(std::vector<std::int16_t>{-32768, 0, 0, 32767, 0, 0, 0, 32767, 0}), kI16, 3,
+                 "VEC3", norm);
+  const int nrm = g.accessor(g.view(std::vector<std::int8_t>{0, 0, 127, 0, 0, 127, 0, 0, 127}), kI8,
+                             3, "VEC3", norm);
+  const int uv = g.accessor(g.view(std::vector<std::uint16_t>{0, 0, 65535, 0, 0, 65535}), kU16, 3,
+                            "VEC2", norm);
+  const int rgba =
+      g.accessor(g.view(std::vector<std::uint8_t>{255, 0, 0, 255, 0, 255, 0, 51, 0, 0, 255, 0}),
+                 kU8, 3, "VEC4", norm);
+  const int rgb = g.accessor(g.view(std::vector<std::uint16_t>{65535, 0, 0, 0, 32768, 0, 0, 0, 0}),
+                             kU16, 3, "VEC3", norm);
+  g.mesh({prim({{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_0", uv}, {"COLOR_0", rgba}}),
+          prim({{"POSITION", pos}, {"NORMAL", nrm}, {"COLOR_0", rgb}})});
+  g.node("\"mesh\":0", true);
+  const wp::Scene s = wp::load_gltf(g.write("quantized.gltf"));
+  check_invariants(s);
+  ASSERT_EQ(s.triangle_count(), 2u);
+  EXPECT_TRUE(s.warnings.empty());
+  const std::vector<vec3> p = {{-1, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<glm::vec2> t = {{0, 0}, {1, 0}, {0, 1}};
+  const std::vector<glm::vec4> c = {{1, 0, 0, 1}, {0, 1, 0, 0.2f}, {0, 0, 1, 0}};
+  const std::vector<glm::vec4> c3 = {{1, 0, 0, 1}, {0, 32768 / 65535.0f, 0, 1}, {0, 0, 0, 1}};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::uint32_t v = s.indices[i], w = s.indices[3 + i];
+    EXPECT_TRUE(near(s.positions[v], p[i]));
+    EXPECT_TRUE(near(s.normals[v], {0, 0, 1}));
+    EXPECT_LT(glm::length(s.uv0[v] - t[i]), 1e-6f);
+    EXPECT_LT(glm::length(s.color0[v] - c[i]), 1e-6f);
+    EXPECT_LT(glm::length(s.uv0[w]), 1e-6f);  // TEXCOORD_0 absent: (0, 0)
+    EXPECT_LT(glm::length(s.color0[w] - c3[i]), 1e-6f);
+  }
+}
+
+// Sparse accessors: over a bufferView (vertex 1 replaced by (5,5,5)) and over zeros (no
+// bufferView; vertices 1 and 2 set).
+TEST(GltfLoader, SparseAccessors) {
+  Gltf g;
+  const int base = g.view(std::vector<vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  const int idx = g.view(std::vector<std::uint16_t>{1, 2});
+  const int val = g.view(std::vector<vec3>{{5, 5, 5}, {0, 1, 0}});
+  const std::string sparse1 =
+      ",\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":" + std::to_string(idx) +
+      ",\"componentType\":5123},\"values\":{" + "\"bufferView\":" + std::to_string(val) + "}}";
+  const std::string sparse2 =
+      ",\"sparse\":{\"count\":2,\"indices\":{\"bufferView\":" + std::to_string(idx) +
+      ",\"componentType\":5123},\"values\":{" +
+      "\"bufferView\":" + std::to_string(g.view(std::vector<vec3>{{1, 0, 0}, {0, 1, 0}})) + "}}";
+  const int a1 = g.accessor(base, kF32, 3, "VEC3", sparse1);
+  const int a2 = g.accessor(-1, kF32, 3, "VEC3", sparse2);
+  g.mesh({prim({{"POSITION", a1}}), prim({{"POSITION", a2}})});
+  g.node("\"mesh\":0", true);
+  const wp::Scene s = wp::load_gltf(g.write("sparse.gltf"));
+  check_invariants(s);
+  ASSERT_EQ(s.triangle_count(), 2u);
+  EXPECT_TRUE(near(corner(s, 0, 1), {5, 5, 5}));
+  EXPECT_TRUE(near(corner(s, 0, 2), {0, 1, 0}));
+  EXPECT_TRUE(near(corner(s, 1, 0), {0, 0, 0}));
+  EXPECT_TRUE(near(corner(s, 1, 1), {1, 0, 0}));
+  EXPECT_TRUE(near(corner(s, 1, 2), {0, 1, 0}));
+}
+
+// Points and lines are skipped with one warning per primitive, however often it is instanced.
+TEST(GltfLoader, NonTrianglePrimitivesWarnOnce) {
+  Gltf g = one_triangle("");
+  g.mesh({prim({{"POSITION", 0}}, -1, 1), prim({{"POSITION", 0}}, -1, 0)});
+  g.node("\"mesh\":1", true);
+  g.node("\"mesh\":1", true);
+  const wp::Scene s = wp::load_gltf(g.write("lines.gltf"));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_NE(s.warnings[0].find("LINES"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[1].find("POINTS"), std::string::npos) << s.warnings[1];
+}
+
+// ---------------------------------------------------------------------------------------------
+// Materials, lights, cameras, scenes
+
+// m0 has every supported field; m1 is empty (glTF defaults). Primitives: m0, none, m1, and a
+// second mesh with none: the default material is appended once, after the file's materials.
+TEST(GltfLoader, MaterialFactorsAndDefaultMaterial) {
+  Gltf g = one_triangle("");
+  g.materials = {
+      R"({"name":"m0","pbrMetallicRoughness":{"baseColorFactor":[0.5,0.25,0.125,0.75],
+          "metallicFactor":0.2,"roughnessFactor":0.7},"emissiveFactor":[1,0.5,0.25],
+          "doubleSided":true,"alphaMode":"MASK","alphaCutoff":0.3,
+          "extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4},
+          "KHR_materials_ior":{"ior":1.33},"KHR_materials_transmission":{"transmissionFactor":0.9}}})",
+      R"({"name":"m1","alphaMode":"BLEND"})"};
+  g.meshes = {"{\"primitives\":[" +
+                  join({prim({{"POSITION", 0}}, -1, -1, 0), prim({{"POSITION", 0}}),
+                        prim({{"POSITION", 0}}, -1, -1, 1)}) +
+                  "]}",
+              "{\"primitives\":[" + prim({{"POSITION", 0}}) + "]}"};
+  g.node("\"mesh\":1", true);
+  const wp::Scene s = wp::load_gltf(g.write("materials.gltf"));
+  check_invariants(s);
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_EQ(s.triangle_material, (std::vector<std::uint32_t>{0, 2, 1, 2}));
+  const wp::Material& m0 = s.materials[0];
+  EXPECT_EQ(m0.name, "m0");
+  EXPECT_EQ(m0.base_color, glm::vec4(0.5f, 0.25f, 0.125f, 0.75f));
+  EXPECT_FLOAT_EQ(m0.metallic, 0.2f);
+  EXPECT_FLOAT_EQ(m0.roughness, 0.7f);
+  EXPECT_EQ(m0.emission, vec3(4, 2, 1));
+  EXPECT_TRUE(m0.double_sided);
+  EXPECT_EQ(m0.alpha_mode, wp::AlphaMode::kMask);
+  EXPECT_FLOAT_EQ(m0.alpha_cutoff, 0.3f);
+  EXPECT_FLOAT_EQ(m0.ior, 1.33f);
+  EXPECT_FLOAT_EQ(m0.transmission, 0.9f);
+  const wp::Material& m1 = s.materials[1];
+  EXPECT_EQ(m1.alpha_mode, wp::AlphaMode::kBlend);
+  for (const wp::Material* m : {&m1, &s.materials[2]}) {
+    EXPECT_EQ(m->base_color, glm::vec4(1.0f));
+    EXPECT_EQ(m->metallic, 1.0f);
+    EXPECT_EQ(m->roughness, 1.0f);
+    EXPECT_EQ(m->emission, vec3(0.0f));
+    EXPECT_FALSE(m->double_sided);
+    EXPECT_EQ(m->ior, 1.5f);
+    EXPECT_EQ(m->transmission, 0.0f);
+  }
+  EXPECT_EQ(s.materials[2].alpha_mode, wp::AlphaMode::kOpaque);
+
+  // Every primitive has a material: no default is added.
+  Gltf h = one_triangle("");
+  h.materials = {"{}"};
+  h.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, -1, 0) + "]}"};
+  EXPECT_EQ(wp::load_gltf(h.write("one_material.gltf")).materials.size(), 1u);
+}
+
+// Parent P = T(0,0,5) R_x(90 deg); R_x(90) maps (x,y,z) to (x,-z,y). Point child at (1,2,0):
+// (0,0,5) + (1,0,2) = (1,0,7). Spot child untransformed: at (0,0,5), direction R(0,0,-1) =
+// (0,1,0). Directional root rotated R_y(90) ((x,y,z) -> (z,y,-x)): direction (-1,0,0).
+TEST(GltfLoader, PunctualLights) {
+  Gltf g = one_triangle("");
+  g.top = R"("extensionsUsed":["KHR_lights_punctual"])";
+  g.lights = {R"({"type":"point","color":[1,0.5,0.25],"intensity":8,"range":10,"name":"p"})",
+              R"({"type":"spot","spot":{}})", R"({"type":"directional","intensity":3})",
+              R"({"type":"spot","spot":{"innerConeAngle":0.1,"outerConeAngle":0.5}})"};
+  const auto light = [](int i) {
+    return "\"extensions\":{\"KHR_lights_punctual\":{\"light\":" + std::to_string(i) + "}}";
+  };
+  // Node 0 is the triangle; 1 is P with children 2 (point) and 3 (spot); 4 and 5 are roots.
+  g.node("\"translation\":[0,0,5],\"rotation\":[0.70710678,0,0,0.70710678],\"children\":[2,3]",
+         true);
+  g.node("\"translation\":[1,2,0]," + light(0));
+  g.node(light(1));
+  g.node("\"rotation\":[0,0.70710678,0,0.70710678]," + light(2), true);
+  g.node(light(3), true);
+  const wp::Scene s = wp::load_gltf(g.write("lights.gltf"));
+  ASSERT_EQ(s.lights.size(), 4u);
+  const wp::PunctualLight &point = s.lights[0], &spot = s.lights[1];
+  EXPECT_EQ(point.type, wp::LightType::kPoint);
+  EXPECT_EQ(point.name, "p");
+  EXPECT_TRUE(near(point.position, {1, 0, 7}));
+  EXPECT_EQ(point.intensity, vec3(8, 4, 2));
+  EXPECT_EQ(point.range, 10.0f);
+  EXPECT_EQ(spot.type, wp::LightType::kSpot);
+  EXPECT_TRUE(near(spot.position, {0, 0, 5}));
+  EXPECT_TRUE(near(spot.direction, {0, 1, 0}));
+  EXPECT_EQ(spot.intensity, vec3(1.0f));
+  EXPECT_EQ(spot.range, 0.0f);
+  EXPECT_EQ(spot.inner_cone, 0.0f);
+  EXPECT_NEAR(spot.outer_cone, kPi / 4, 1e-6f);
+  EXPECT_EQ(s.lights[2].type, wp::LightType::kDirectional);
+  EXPECT_TRUE(near(s.lights[2].direction, {-1, 0, 0}));
+  EXPECT_EQ(s.lights[2].intensity, vec3(3.0f));
+  EXPECT_FLOAT_EQ(s.lights[3].inner_cone, 0.1f);
+  EXPECT_FLOAT_EQ(s.lights[3].outer_cone, 0.5f);
+}
+
+// Roots A (T(0,1,0) S(2), child A1) and B. A1 = T(1,0,0) R_y(90) holds the orthographic camera:
+// position (0,1,0) + 2 (1,0,0) = (2,1,0), forward R_y(-Z) = (-1,0,0), up +Y (scale ignored).
+// B = T(0,0,5) R_x(90) holds the perspective one: forward (0,1,0), up R_x(+Y) = (0,0,1).
+// Depth-first node order puts A1's camera first.
+TEST(GltfLoader, CamerasInNodeOrder) {
+  Gltf g = one_triangle("");
+  g.cameras = {
+      R"({"type":"perspective","perspective":{"yfov":0.7,"znear":0.1,"aspectRatio":1.5}})",
+      R"({"type":"orthographic","orthographic":{"xmag":2,"ymag":1.5,"znear":0.01,"zfar":100}})"};
+  g.node("\"translation\":[0,1,0],\"scale\":[2,2,2],\"children\":[3]", true);
+  g.node("\"camera\":0,\"translation\":[0,0,5],\"rotation\":[0.70710678,0,0,0.70710678]", true);
+  g.node("\"camera\":1,\"translation\":[1,0,0],\"rotation\":[0,0.70710678,0,0.70710678]");
+  const wp::Scene s = wp::load_gltf(g.write("cameras.gltf"));
+  ASSERT_EQ(s.cameras.size(), 2u);
+  const wp::Camera &ortho = s.cameras[0], &persp = s.cameras[1];
+  EXPECT_EQ(ortho.type, wp::CameraType::kOrthographic);
+  EXPECT_TRUE(near(ortho.position, {2, 1, 0}));
+  EXPECT_TRUE(near(ortho.forward, {-1, 0, 0}));
+  EXPECT_TRUE(near(ortho.up, {0, 1, 0}));
+  EXPECT_EQ(ortho.xmag, 2.0f);
+  EXPECT_EQ(ortho.ymag, 1.5f);
+  EXPECT_EQ(ortho.znear, 0.01f);
+  EXPECT_EQ(persp.type, wp::CameraType::kPerspective);
+  EXPECT_TRUE(near(persp.position, {0, 0, 5}));
+  EXPECT_TRUE(near(persp.forward, {0, 1, 0}));
+  EXPECT_TRUE(near(persp.up, {0, 0, 1}));
+  EXPECT_EQ(persp.yfov, 0.7f);
+  EXPECT_EQ(persp.znear, 0.1f);
+}
+
+// "scene": 1 picks the second scene; without "scene", scene 0 is used.
+TEST(GltfLoader, DefaultScene) {
+  Gltf g = one_triangle("");
+  g.node("\"mesh\":0,\"translation\":[10,0,0]");
+  g.scenes = R"("scene":1,"scenes":[{"nodes":[0]},{"nodes":[1]}])";
+  EXPECT_TRUE(near(wp::load_gltf(g.write("scene1.gltf")).bounds_lo, {10, 0, 0}));
+  g.scenes = R"("scenes":[{"nodes":[0]},{"nodes":[1]}])";
+  EXPECT_TRUE(near(wp::load_gltf(g.write("scene0.gltf")).bounds_lo, {0, 0, 0}));
+}
+
+TEST(GltfLoader, ExtensionAndTextureWarnings) {
+  Gltf g = one_triangle("");
+  g.top = R"("extensionsUsed":["KHR_materials_volume","KHR_materials_ior"],)"
+          R"("textures":[{"source":0}],"images":[{"uri":"data:image/png;base64,AAAA"}])";
+  const wp::Scene s = wp::load_gltf(g.write("warn.gltf"));
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_NE(s.warnings[0].find("KHR_materials_volume"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[1].find("textures are not supported yet"), std::string::npos);
+}
+
+TEST(GltfLoader, FramingCamera) {
+  wp::Scene s;
+  s.bounds_lo = vec3(-1, 0, -3);
+  s.bounds_hi = vec3(3, 2, 1);
+  for (const float aspect : {1.0f, 0.5f, 2.0f}) {
+    const wp::Camera c = wp::framing_camera(s, aspect);
+    EXPECT_EQ(c.type, wp::CameraType::kPerspective);
+    EXPECT_NEAR(c.yfov, kPi / 4, 1e-6f);
+    EXPECT_LT(c.forward.z, -0.9f);  // along -Z ...
+    EXPECT_LT(c.forward.y, 0.0f);   // ... slightly from above
+    EXPECT_NEAR(glm::dot(c.forward, c.up), 0.0f, 1e-6f);
+    const vec3 center(1, 1, -1);
+    EXPECT_TRUE(near(glm::normalize(center - c.position), c.forward));
+    // The bounding sphere (radius 3) touches the tighter side of the view.
+    const float half = std::min(kPi / 8, std::atan(std::tan(kPi / 8) * aspect));
+    EXPECT_NEAR(glm::length(center - c.position) * std::sin(half), 3.0f, 1e-4f);
+  }
+  s.bounds_lo = s.bounds_hi = vec3(4, 5, 6);  // a point
+  const wp::Camera c = wp::framing_camera(s, 1.0f);
+  EXPECT_TRUE(std::isfinite(c.position.x + c.position.y + c.position.z));
+  EXPECT_GT(glm::length(c.position - vec3(4, 5, 6)), 0.0f);
+  EXPECT_NEAR(glm::length(c.forward), 1.0f, 1e-6f);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed input: wp::Error naming the file and the cause, never a crash.
+
+TEST(GltfLoader, ErrorsNameFileAndCause) {
+  Gltf g = one_triangle("");
+  g.top = R"("extensionsUsed":["KHR_draco_mesh_compression"],)"
+          R"("extensionsRequired":["KHR_draco_mesh_compression"])";
+  expect_error(g.write("draco.gltf"), "requires unsupported extension KHR_draco_mesh_compression");
+
+  const std::string missing = (temp_dir() / "missing.gltf").string();
+  expect_error(missing, "no such file");
+  const std::string bad_json = (temp_dir() / "bad.gltf").string();
+  write_bytes(bad_json, R"({"asset":{"version":"2.0"},"nodes":[{"mesh":0})");
+  expect_error(bad_json, "parse error");
+  const std::string empty = (temp_dir() / "empty.gltf").string();
+  write_bytes(empty, "");
+  expect_error(empty, "empty file");
+  expect_error(temp_dir().string(), "is a directory");
+  const std::string not_glb = (temp_dir() / "text.glb").string();
+  write_bytes(not_glb, "{}");
+  expect_error(not_glb, "magic");
+
+  Gltf none = one_triangle("");
+  none.scenes = "";
+  expect_error(none.write("noscene.gltf"), "no scenes");
+  Gltf lines = one_triangle("");
+  lines.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, 1) + "]}"};
+  expect_error(lines.write("nolines.gltf"), "no triangles");
+}
+
+TEST(GltfLoader, OutOfRangeDataIsAnError) {
+  {  // accessor count beyond its bufferView
+    Gltf g = one_triangle("");
+    g.accessors[0] = R"({"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"})";
+    expect_error(g.write("count.gltf"), "accessor 0 (POSITION)");
+  }
+  {  // index value beyond the vertices
+    Gltf g = one_triangle("");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, g.indices<std::uint16_t>({0, 1, 7})) +
+                "]}"};
+    expect_error(g.write("index.gltf"), "index 7");
+  }
+  {  // bufferView beyond its buffer
+    Gltf g = one_triangle("");
+    g.views[0] = R"({"buffer":0,"byteOffset":4,"byteLength":36})";
+    expect_error(g.write("view.gltf"), "exceeds buffer 0");
+  }
+  {  // missing accessor, matrix-typed accessor, attribute count mismatch
+    Gltf g = one_triangle("");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 9}}) + "]}"};
+    expect_error(g.write("noaccessor.gltf"), "accessor 9 (POSITION) does not exist");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", g.accessor(0, kF32, 1, "MAT3")}}) + "]}"};
+    expect_error(g.write("mat3.gltf"), "unsupported accessor type");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}, {"NORMAL", g.vec3s({{0, 0, 1}})}}) +
+                "]}"};
+    expect_error(g.write("mismatch.gltf"), "differs from POSITION");
+  }
+  {  // node graph: a cycle, a missing child, a missing mesh, a malformed transform
+    Gltf g = one_triangle("\"children\":[1]");
+    g.node("\"children\":[0]");
+    expect_error(g.write("cycle.gltf"), "cycle");
+    g.nodes[1] = "{\"children\":[5]}";
+    expect_error(g.write("child.gltf"), "missing node 5");
+    g.nodes = {"{\"mesh\":3}"};
+    expect_error(g.write("nomesh.gltf"), "mesh 3 does not exist");
+    g.nodes = {"{\"mesh\":0,\"rotation\":[0,0,1]}"};
+    expect_error(g.write("rotation.gltf"), "rotation needs 4 numbers");
+  }
+  {  // a material and a light that do not exist
+    Gltf g = one_triangle("");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, -1, 2) + "]}"};
+    expect_error(g.write("nomaterial.gltf"), "material 2 does not exist");
+    Gltf h = one_triangle(R"("extensions":{"KHR_lights_punctual":{"light":0}})");
+    expect_error(h.write("nolight.gltf"), "light 0 does not exist");
+  }
+}
+
+// Every truncation of a valid .glb, and random byte corruptions of it, either load or throw
+// wp::Error (run under ASan or valgrind to check for out-of-range reads).
+TEST(GltfLoader, TruncatedAndCorruptedGlbNeverCrash) {
+  const std::string bytes = hierarchy().glb();
+  const std::string path = (temp_dir() / "mutant.glb").string();
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    write_bytes(path, bytes.substr(0, n));
+    EXPECT_THROW(wp::load_gltf(path), wp::Error) << "truncated to " << n;
+  }
+  std::mt19937 rng(7);
+  int loaded = 0;
+  for (int i = 0; i < 1500; ++i) {
+    std::string m = bytes;
+    for (int k = 0; k < 1 + i % 3; ++k) m[rng() % m.size()] = "\x00\xff\x7f:,[]}\"-9e0"[rng() % 13];
+    write_bytes(path, m);
+    try {
+      check_invariants(wp::load_gltf(path));
+      ++loaded;
+    } catch (const wp::Error&) {
+    }
+  }
+  EXPECT_GT(loaded, 0);  // some mutations are harmless (e.g. inside a name)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Real-world assets (../shared/assets; skipped when absent)
+
+TEST(GltfAssets, Box) {
+  WP_REQUIRE_MODEL(path, "Box/Box.glb");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  EXPECT_EQ(s.triangle_count(), 12u);
+  EXPECT_EQ(s.materials.size(), 1u);
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_TRUE(near(s.bounds_lo, vec3(-0.5f)));
+  EXPECT_TRUE(near(s.bounds_hi, vec3(0.5f)));
+}
+
+TEST(GltfAssets, Cameras) {
+  WP_REQUIRE_MODEL(path, "Cameras/Cameras.gltf");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  ASSERT_EQ(s.cameras.size(), 2u);
+  EXPECT_EQ(s.cameras[0].type, wp::CameraType::kPerspective);
+  EXPECT_FLOAT_EQ(s.cameras[0].yfov, 0.7f);
+  EXPECT_FLOAT_EQ(s.cameras[0].znear, 0.01f);
+  EXPECT_EQ(s.cameras[1].type, wp::CameraType::kOrthographic);
+  EXPECT_EQ(s.cameras[1].xmag, 1.0f);
+  EXPECT_EQ(s.cameras[1].ymag, 1.0f);
+  for (const wp::Camera& c : s.cameras) {
+    EXPECT_TRUE(near(c.position, {0.5f, 0.5f, 3.0f}));
+    EXPECT_TRUE(near(c.forward, {0, 0, -1}));
+  }
+}
+
+TEST(GltfAssets, LightsPunctualLamp) {
+  WP_REQUIRE_MODEL(path, "LightsPunctualLamp/LightsPunctualLamp.gltf");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  ASSERT_EQ(s.lights.size(), 5u);
+  for (const wp::PunctualLight& l : s.lights) EXPECT_EQ(l.type, wp::LightType::kPoint);
+}
+
+// Mirrored nodes: smooth triangles' fronts (counter-clockwise) agree with their normals.
+TEST(GltfAssets, NegativeScaleTest) {
+  WP_REQUIRE_MODEL(path, "NegativeScaleTest/NegativeScaleTest.glb");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  std::size_t agree = 0;
+  for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+    const vec3 n = s.normals[s.indices[3 * t]] + s.normals[s.indices[3 * t + 1]] +
+                   s.normals[s.indices[3 * t + 2]];
+    agree +=
+        glm::dot(glm::cross(corner(s, t, 1) - corner(s, t, 0), corner(s, t, 2) - corner(s, t, 0)),
+                 n) > 0.0f;
+  }
+  EXPECT_GT(agree, s.triangle_count() * 99 / 100);
+}
+
+TEST(GltfAssets, CornellBox) {
+  WP_REQUIRE_MODEL(path, "CornellBox/CornellBox.glb");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  EXPECT_EQ(s.materials[0].emission, vec3(100.0f));  // emissiveFactor 1 x emissiveStrength 100
+  EXPECT_TRUE(s.materials[0].double_sided);
+  // The emitter's COLOR_0 is u16 normalized 65535 everywhere: exactly white.
+  for (const glm::vec4& c : s.color0) EXPECT_EQ(c, glm::vec4(1.0f));
+}
+
+// COLOR_0 as float VEC4 that is not white everywhere.
+TEST(GltfAssets, VertexColorTest) {
+  WP_REQUIRE_MODEL(path, "VertexColorTest/VertexColorTest.glb");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  EXPECT_TRUE(std::any_of(s.color0.begin(), s.color0.end(),
+                          [](const glm::vec4& c) { return c != glm::vec4(1.0f); }));
+}
+
+TEST(GltfAssets, MetalRoughSpheresNoTextures) {
+  WP_REQUIRE_MODEL(path, "MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  EXPECT_EQ(s.triangle_count(), 1040409u);
+  EXPECT_EQ(s.materials.size(), 99u);  // 98 + the default, used by 25 primitives
+}
+
+// Every model loads with triangles, except exactly those requiring an unsupported extension.
+TEST(GltfAssets, AllModels) {
+  const fs::path models = fs::path(wp::test::assets_dir()) / "models";
+  if (!fs::is_directory(models)) GTEST_SKIP() << "no assets under " << models;
+  const std::map<std::string, std::string> expected_failures = {
+      {"GlamVelvetSofa", "KHR_texture_transform"},
+      {"IridescenceSuzanne", "KHR_materials_iridescence"}};
+  int count = 0;
+  for (const auto& dir : fs::directory_iterator(models)) {
+    for (const auto& file : fs::directory_iterator(dir.path())) {
+      const std::string ext = file.path().extension().string();
+      if (ext != ".glb" && ext != ".gltf") continue;
+      ++count;
+      const std::string name = dir.path().filename().string();
+      const auto failure = expected_failures.find(name);
+      SCOPED_TRACE(file.path().string());
+      if (failure != expected_failures.end()) {
+        expect_error(file.path().string(), "requires unsupported extension " + failure->second);
+      } else {
+        check_invariants(wp::load_gltf(file.path().string()));
+      }
+    }
+  }
+  EXPECT_EQ(count, 39);
+}
+
+}  // namespace
