@@ -1,0 +1,24 @@
+// Layout checks of the structs shared with OpenCL C (kernels/shared/). OpenCL C aligns float4,
+// int4 and uint4 to 16 bytes and lays struct members out in order with natural alignment; these
+// assertions pin the C++ side to the same sizes and offsets.
+#include <cstddef>
+
+#include "kernels/shared/types.h"
+
+namespace wp::dev {
+
+static_assert(sizeof(float4) == 16 && alignof(float4) == 16);
+static_assert(sizeof(int4) == 16 && sizeof(uint4) == 16);
+static_assert(sizeof(BvhNode) == 64);
+static_assert(offsetof(BvhNode, link) == 48);
+static_assert(sizeof(IsectTri) == 48);
+static_assert(sizeof(Material) == 64);
+static_assert(sizeof(PunctualLight) == 80);
+static_assert(sizeof(Camera) == 80);
+static_assert(offsetof(SceneDesc, background) == 80);
+static_assert(offsetof(SceneDesc, bvh_nodes) == 96);
+static_assert(sizeof(SceneDesc) == 144);
+static_assert(sizeof(Launch) == 48);
+static_assert(sizeof(PathLayout) % 4 == 0);
+
+}  // namespace wp::dev

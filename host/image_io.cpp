@@ -1,0 +1,145 @@
+#include "host/image_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <stb_image_write.h>
+
+#include "host/error.h"
+
+namespace wp {
+
+namespace {
+
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+void write_exr(const std::string& path, const ImageRgb& img,
+               const std::map<std::string, std::string>& attributes) {
+  Imf::Header header(img.width, img.height);
+  for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+  for (const auto& [key, value] : attributes) header.insert(key, Imf::StringAttribute(value));
+  Imf::FrameBuffer fb;
+  const std::size_t xs = 3 * sizeof(float), ys = xs * static_cast<std::size_t>(img.width);
+  char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgb.data()));
+  fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+  fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+  fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+  Imf::OutputFile file(path.c_str(), header);
+  file.setFrameBuffer(fb);
+  file.writePixels(img.height);
+}
+
+float tonemap(float x, Tonemap t) {
+  if (t == Tonemap::kAces) {  // a rational fit of the ACES filmic curve (Narkowicz 2015)
+    x = std::max(x, 0.0f);
+    return (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
+  }
+  return x;
+}
+
+void write_png(const std::string& path, const ImageRgb& img, const PngOptions& png) {
+  std::vector<unsigned char> bytes(img.rgb.size());
+  for (std::size_t i = 0; i < img.rgb.size(); ++i) bytes[i] = png_encode(img.rgb[i], png);
+  if (!stbi_write_png(path.c_str(), img.width, img.height, 3, bytes.data(), img.width * 3))
+    throw Error("cannot write " + path);
+}
+
+std::string temporary_name(const std::string& path) {
+  static std::mt19937_64 rng{std::random_device{}()};
+  const std::filesystem::path p(path);
+  // Keep the extension last: OpenEXR and stb do not care, but it keeps temp files recognisable.
+  return (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(rng() % 1000000) +
+                             p.extension().string()))
+      .string();
+}
+
+}  // namespace
+
+unsigned char png_encode(float linear, const PngOptions& png) {
+  float x = tonemap(linear * std::exp2(png.exposure), png.tonemap);
+  if (!(x > 0.0f)) x = 0.0f;  // also NaN
+  x = std::min(x, 1.0f);
+  const float s = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+  return static_cast<unsigned char>(std::lround(s * 255.0f));
+}
+
+void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
+                  const std::map<std::string, std::string>& exr_attributes, const PngOptions& png) {
+  for (const auto& path : paths) {
+    const std::string ext = extension_of(path);
+    if (ext != ".exr" && ext != ".png")
+      throw Error(path + ": unsupported output format (use .exr or .png)");
+  }
+  std::vector<std::string> temps;
+  const auto remove_temps = [&] {
+    for (const auto& t : temps) std::remove(t.c_str());
+  };
+  try {
+    for (const auto& path : paths) {
+      temps.push_back(temporary_name(path));
+      if (extension_of(path) == ".exr")
+        write_exr(temps.back(), image, exr_attributes);
+      else
+        write_png(temps.back(), image, png);
+    }
+    for (std::size_t i = 0; i < paths.size(); ++i) std::filesystem::rename(temps[i], paths[i]);
+  } catch (const Error& e) {
+    remove_temps();
+    throw;
+  } catch (const std::exception& e) {
+    remove_temps();
+    throw Error("cannot write " + paths[temps.empty() ? 0 : temps.size() - 1] + ": " + e.what());
+  }
+}
+
+ImageRgb read_exr(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    ImageRgb img;
+    img.width = dw.max.x - dw.min.x + 1;
+    img.height = dw.max.y - dw.min.y + 1;
+    img.rgb.assign(3 * std::size_t(img.width) * std::size_t(img.height), 0.0f);
+    const std::size_t xs = 3 * sizeof(float), ys = xs * static_cast<std::size_t>(img.width);
+    char* base = reinterpret_cast<char*>(img.rgb.data()) - dw.min.x * std::ptrdiff_t(xs) -
+                 dw.min.y * std::ptrdiff_t(ys);
+    Imf::FrameBuffer fb;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return img;
+  } catch (const std::exception& e) {
+    throw Error("cannot read " + path + ": " + e.what());
+  }
+}
+
+std::map<std::string, std::string> read_exr_attributes(const std::string& path) {
+  std::map<std::string, std::string> out;
+  try {
+    Imf::InputFile file(path.c_str());
+    for (auto it = file.header().begin(); it != file.header().end(); ++it)
+      if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+        out[it.name()] = s->value();
+  } catch (const std::exception& e) {
+    throw Error("cannot read " + path + ": " + e.what());
+  }
+  return out;
+}
+
+}  // namespace wp

@@ -1,0 +1,39 @@
+// Image output: linear float OpenEXR with the render settings as header attributes, and an 8-bit
+// sRGB PNG preview. Writes are atomic: each file is written beside its destination under a
+// temporary name and renamed into place only when every file of the set is complete, so a failed
+// run leaves no partial file and overwrites nothing.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace wp {
+
+struct ImageRgb {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // linear, row by row from the top, 3 floats per pixel
+};
+
+enum class Tonemap { kClamp, kAces };
+
+struct PngOptions {
+  float exposure = 0.0f;  // stops: the image is scaled by 2^exposure before tonemapping
+  Tonemap tonemap = Tonemap::kAces;
+};
+
+// Writes each of `paths` (by extension: .exr or .png) atomically as a set. Throws wp::Error naming
+// the file on failure (an unknown extension, an unwritable folder), after removing what it wrote.
+void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
+                  const std::map<std::string, std::string>& exr_attributes,
+                  const PngOptions& png = {});
+
+// Reads an OpenEXR file's R, G, B channels as linear float. Throws wp::Error on failure.
+ImageRgb read_exr(const std::string& path);
+// Reads the string attributes of an OpenEXR header.
+std::map<std::string, std::string> read_exr_attributes(const std::string& path);
+
+// The 8-bit sRGB value PNG output stores for a linear value (after exposure and tonemap).
+unsigned char png_encode(float linear, const PngOptions& png);
+
+}  // namespace wp

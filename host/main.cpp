@@ -1,0 +1,199 @@
+// wavepath: the command line. `wavepath render SCENE` and `wavepath devices`.
+// Errors of every kind end here, in one place: one line on stderr, exit status 1.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "host/cl_runtime.h"
+#include "host/error.h"
+#include "host/gltf_loader.h"
+#include "host/render.h"
+#include "host/report_json.h"
+
+namespace {
+
+struct CliOptions {
+  std::string scene;
+  std::vector<std::string> outputs;
+  std::string device;
+  std::vector<float> env_color{0.0f, 0.0f, 0.0f};
+  std::string features = "scene";
+  std::string tonemap = "aces";
+  float exposure = 0.0f;
+  bool spatial_splits = false;
+  bool json = false;
+  bool quiet = false;
+};
+
+int list_devices() {
+  const auto devices = wp::enumerate_devices();
+  if (devices.empty())
+    throw wp::Error("no OpenCL platform found (install pocl-opencl-icd for CPUs)");
+  std::printf("%-5s %-11s %-16s %s\n", "index", "type", "OpenCL C", "platform / device");
+  for (const auto& d : devices)
+    std::printf("%-5d %-11s %-16s %s / %s\n", d.index, d.type.c_str(),
+                d.c_version.substr(d.c_version.find("OpenCL C") == 0 ? 9 : 0).c_str(),
+                d.platform_name.c_str(), d.name.c_str());
+  const wp::DeviceEntry def = wp::select_device("");
+  std::printf("default: %d (%s)\n", def.index, def.name.c_str());
+  return 0;
+}
+
+// Fails before any rendering when an output could not be written at the end.
+void check_outputs(const std::vector<std::string>& outputs) {
+  for (const auto& o : outputs) {
+    const std::filesystem::path p(o);
+    std::string ext = p.extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".exr" && ext != ".png")
+      throw wp::Error(o + ": unsupported output format (use .exr or .png)");
+    const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
+    if (!std::filesystem::is_directory(dir))
+      throw wp::Error(o + ": folder " + dir.string() + " does not exist");
+  }
+}
+
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled) {}
+  void operator()(int done, int total, double seconds) const {
+    if (!enabled_) return;
+    const double eta = seconds / done * (total - done);
+    std::fprintf(stderr, "\r  %d/%d spp  %5.1f%%  %6.1fs elapsed  ETA %6.1fs ", done, total,
+                 100.0 * done / total, seconds, eta);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_;
+};
+
+int render_command(CliOptions& cli, wp::RenderSettings& settings) {
+  if (cli.outputs.empty()) cli.outputs = {"render.exr", "render.png"};
+  check_outputs(cli.outputs);
+  settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
+  settings.all_features = cli.features == "all";
+  wp::validate(settings);
+
+  const auto start = std::chrono::steady_clock::now();
+  const wp::Scene scene = wp::load_gltf(cli.scene);
+  const double load_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!cli.quiet)
+    for (const auto& w : scene.warnings) std::fprintf(stderr, "wavepath: warning: %s\n", w.c_str());
+
+  wp::ClRuntime runtime(wp::select_device(cli.device));
+  wp::RenderOptions options;
+  options.bvh.spatial_splits = cli.spatial_splits;
+  options.progress = Progress(!cli.quiet && isatty(STDERR_FILENO));
+  const wp::Rendered result = wp::render(runtime, scene, settings, options);
+
+  wp::PngOptions png;
+  png.exposure = cli.exposure;
+  png.tonemap = cli.tonemap == "clamp" ? wp::Tonemap::kClamp : wp::Tonemap::kAces;
+  wp::write_images(cli.outputs, result.image,
+                   wp::exr_attributes(cli.scene, settings, result.report), png);
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (result.report.nonfinite_samples > 0)
+    std::fprintf(stderr, "wavepath: warning: %llu NaN/Inf samples were left out of the film\n",
+                 static_cast<unsigned long long>(result.report.nonfinite_samples));
+  if (cli.json)
+    std::cout << wp::report_json(settings, result.report, load_seconds, total, cli.outputs) << "\n";
+  else if (!cli.quiet)
+    std::fprintf(stderr, "wavepath: %s: %d spp in %.2f s (%.3g samples/s) on %s; wrote %s\n",
+                 cli.scene.c_str(), settings.spp, result.report.render_seconds,
+                 result.report.samples_per_second(settings), result.report.device.c_str(),
+                 cli.outputs.front().c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"wavepath: an OpenCL wavefront path tracer for glTF 2.0 scenes", "wavepath"};
+  app.require_subcommand(1);
+  // Parse errors in one line, like every other error.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("wavepath: error: ") + e.what() + " (see --help)\n";
+  });
+  app.set_version_flag("--version", "wavepath 0.1.0");
+  CLI::App* devices = app.add_subcommand("devices", "List OpenCL platforms and devices");
+
+  CliOptions cli;
+  wp::RenderSettings settings;
+  CLI::App* render = app.add_subcommand("render", "Render a glTF scene to OpenEXR and/or PNG");
+  render->add_option("scene", cli.scene, "glTF 2.0 file (.gltf or .glb)")->required();
+  render->add_option("-o,--output", cli.outputs,
+                     "Output file(s): .exr = linear float RGB with the settings in its header, "
+                     ".png = 8-bit sRGB preview [default: render.exr render.png]");
+  render->add_option("--width", settings.width, "Image width in pixels")->capture_default_str();
+  render->add_option("--height", settings.height, "Image height in pixels")->capture_default_str();
+  render->add_option("--spp", settings.spp, "Samples per pixel")->capture_default_str();
+  render->add_option("--camera", settings.camera,
+                     "Camera index in node order [default: the first, else one framing the scene]");
+  render
+      ->add_option("--env-color", cli.env_color,
+                   "Constant background radiance R,G,B (linear) [default: 0,0,0]")
+      ->delimiter(',')
+      ->expected(3);
+  render->add_option("--max-depth", settings.max_depth, "Most scattering events per path")
+      ->capture_default_str();
+  render
+      ->add_option("--rr-depth", settings.rr_depth,
+                   "Russian roulette after this many scattering events")
+      ->capture_default_str();
+  render->add_option("--seed", settings.seed, "Random seed (same seed, same image)")
+      ->capture_default_str();
+  render->add_option("--device", cli.device,
+                     "OpenCL device: index or name substring (see `wavepath devices`) "
+                     "[default: first GPU, else first CPU]");
+  render
+      ->add_option("--features", cli.features,
+                   "Kernel specialisation: `scene` (only what the scene uses) or `all`")
+      ->check(CLI::IsMember({"scene", "all"}))
+      ->capture_default_str();
+  render->add_option("--tonemap", cli.tonemap, "PNG tonemap: aces or clamp")
+      ->check(CLI::IsMember({"aces", "clamp"}))
+      ->capture_default_str();
+  render->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
+  render->add_flag("--spatial-splits", cli.spatial_splits,
+                   "Build the BVH with spatial splits (slower build, faster traversal)");
+  render->add_option("--wave-size", settings.wave_size, "Path slots per wave [default: auto]");
+  render->add_option("--local-size", settings.local_size, "Work-group size [default: 64]");
+  render->add_flag("--profile", settings.profile, "Time each kernel (adds stage times to --json)");
+  render->add_flag("--json", cli.json,
+                   "Print a JSON summary as the last line of stdout (spp, width, height, "
+                   "seconds, samples_per_second, device, triangles, kernel_build_seconds, "
+                   "bvh_build_seconds, ...)");
+  render->add_flag("-q,--quiet", cli.quiet, "No progress or warnings on stderr");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (devices->parsed()) return list_devices();
+    return render_command(cli, settings);
+  } catch (const wp::Error& e) {
+    std::cerr << "wavepath: error: " << e.what() << "\n";
+    if (!e.details().empty()) std::cerr << e.details() << "\n";
+    return 1;
+  } catch (const cl::Error& e) {
+    std::cerr << "wavepath: error: OpenCL: " << e.what() << " failed with "
+              << wp::cl_error_name(e.err()) << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "wavepath: error: " << e.what() << "\n";
+    return 1;
+  }
+}

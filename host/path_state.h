@@ -1,0 +1,19 @@
+// The path-state buffer: every field of kernels/shared/path_state.def for `capacity` path slots,
+// each field a 64-byte aligned array in one buffer.
+#pragma once
+
+#include <cstddef>
+
+#include "kernels/shared/types.h"
+
+namespace wp {
+
+struct PathStateLayout {
+  dev::PathLayout layout{};  // byte offsets per field, passed to every kernel
+  std::size_t bytes = 0;     // total buffer size
+  std::size_t bytes_per_path = 0;
+};
+
+PathStateLayout path_state_layout(std::size_t capacity);
+
+}  // namespace wp

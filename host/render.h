@@ -1,0 +1,54 @@
+// One render from a loaded scene to a linear image and a report: BVH build, device set-up,
+// sample passes with progress, read-back.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "bvh/bvh.h"
+#include "host/cl_runtime.h"
+#include "host/image_io.h"
+#include "host/scene.h"
+#include "host/wavefront.h"
+
+namespace wp {
+
+struct RenderReport {
+  std::string device;
+  std::string features;       // the kernel features the program was built with
+  std::string build_options;  // the program's build options
+  std::size_t triangles = 0;
+  bvh::BuildStats bvh;
+  double kernel_build_seconds = 0;  // includes the OpenCL implementation's cache lookup
+  double setup_seconds = 0;         // BVH, upload, program: from scene to first pass
+  double render_seconds = 0;        // sample passes, wall clock
+  double first_pass_seconds = 0;    // from the call to the end of the first pass
+  std::uint64_t nonfinite_samples = 0;
+  std::size_t wave_size = 0;
+  std::size_t bytes_per_path = 0;
+  StageTimes stages;  // with RenderSettings::profile
+  double samples_per_second(const RenderSettings& s) const {
+    return render_seconds > 0 ? double(s.width) * s.height * s.spp / render_seconds : 0.0;
+  }
+};
+
+struct RenderOptions {
+  bvh::BuildOptions bvh;
+  // Called after each sample pass with (passes done, passes in all, seconds since the start).
+  std::function<void(int, int, double)> progress;
+};
+
+struct Rendered {
+  ImageRgb image;
+  RenderReport report;
+};
+
+// Throws wp::Error on invalid settings or device failures.
+Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
+                const RenderOptions& options = {});
+
+// Checks the ranges of user-facing settings; throws wp::Error naming the option.
+void validate(const RenderSettings& settings);
+
+}  // namespace wp

@@ -1,0 +1,88 @@
+#include "host/report_json.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace wp {
+
+namespace {
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+}  // namespace
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::map<std::string, std::string> exr_attributes(const std::string& scene, const RenderSettings& s,
+                                                  const RenderReport& r) {
+  return {{"wavepath:scene", scene},
+          {"wavepath:spp", std::to_string(s.spp)},
+          {"wavepath:max_depth", std::to_string(s.max_depth)},
+          {"wavepath:rr_depth", std::to_string(s.rr_depth)},
+          {"wavepath:seed", std::to_string(s.seed)},
+          {"wavepath:camera", std::to_string(s.camera)},
+          {"wavepath:background",
+           num(s.background.x) + "," + num(s.background.y) + "," + num(s.background.z)},
+          {"wavepath:device", r.device},
+          {"wavepath:features", r.features},
+          {"wavepath:nonfinite_samples", std::to_string(r.nonfinite_samples)},
+          {"wavepath:units", "linear RGB radiance (W/(sr m^2) per channel)"}};
+}
+
+std::string report_json(const RenderSettings& s, const RenderReport& r, double load_seconds,
+                        double total_seconds, const std::vector<std::string>& outputs) {
+  std::ostringstream o;
+  o << "{\"spp\":" << s.spp << ",\"width\":" << s.width << ",\"height\":" << s.height
+    << ",\"seconds\":" << num(r.render_seconds)
+    << ",\"samples_per_second\":" << num(r.samples_per_second(s))
+    << ",\"device\":" << json_string(r.device) << ",\"triangles\":" << r.triangles
+    << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)
+    << ",\"bvh_build_seconds\":" << num(r.bvh.build_seconds)
+    << ",\"bvh_sah_cost\":" << num(r.bvh.sah_cost) << ",\"setup_seconds\":" << num(r.setup_seconds)
+    << ",\"first_pass_seconds\":" << num(r.first_pass_seconds)
+    << ",\"load_seconds\":" << num(load_seconds) << ",\"total_seconds\":" << num(total_seconds)
+    << ",\"nonfinite_samples\":" << r.nonfinite_samples
+    << ",\"features\":" << json_string(r.features) << ",\"wave_size\":" << r.wave_size
+    << ",\"bytes_per_path\":" << r.bytes_per_path << ",\"outputs\":[";
+  for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);
+  o << "]";
+  if (s.profile) {
+    o << ",\"stage_seconds\":{";
+    for (int i = 0; i < kStageCount; ++i)
+      o << (i ? "," : "") << json_string(kStageNames[i]) << ":" << num(r.stages.seconds[i]);
+    o << "}";
+  }
+  o << "}";
+  return o.str();
+}
+
+}  // namespace wp

@@ -1,0 +1,28 @@
+// Which optional kernel features a scene uses. The program is built with one -D WP_FEATURE_X=0|1
+// per feature (kernels/features.h), so absent features cost no code, registers or branches.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "host/scene.h"
+
+namespace wp {
+
+struct SceneFeatures {
+  bool punctual_lights = true;
+  bool spot_lights = true;
+  bool emission = true;
+  bool vertex_colors = true;
+
+  static SceneFeatures all() { return {}; }
+  static SceneFeatures of(const Scene& scene);
+
+  // (macro name, enabled) in a fixed order; drives the build options and the report.
+  std::vector<std::pair<std::string, bool>> flags() const;
+  // "punctual_lights emission" (the enabled ones), or "none".
+  std::string describe() const;
+};
+
+}  // namespace wp

@@ -1,0 +1,202 @@
+#include "host/wavefront.h"
+
+#include <algorithm>
+
+#include "host/device_scene.h"
+#include "host/error.h"
+#include "host/gltf_loader.h"
+#include "host/kernel_sources.h"
+
+namespace wp {
+
+namespace {
+
+// The one place where program build options are assembled.
+std::string program_options(const SceneFeatures& features) {
+  std::string o = "-cl-std=CL1.2";
+  for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
+  return o;
+}
+
+std::string program_source() {
+  std::vector<std::string> files;
+  for (const char* name : kStageNames) files.push_back(std::string(name) + ".cl");
+  return KernelSources().expand(files);
+}
+
+const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
+  const float aspect = static_cast<float>(s.width) / static_cast<float>(s.height);
+  if (s.camera >= 0) {
+    if (static_cast<std::size_t>(s.camera) >= scene.cameras.size())
+      throw Error("--camera " + std::to_string(s.camera) + ": the scene has " +
+                  std::to_string(scene.cameras.size()) + " camera(s)");
+    return device_camera(scene.cameras[s.camera], s.width, s.height);
+  }
+  if (!scene.cameras.empty()) return device_camera(scene.cameras.front(), s.width, s.height);
+  return device_camera(framing_camera(scene, aspect), s.width, s.height);
+}
+
+}  // namespace
+
+Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+                     const RenderSettings& settings)
+    : rt_(runtime), settings_(settings) {
+  const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
+  wave_size_ = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
+  // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
+  // of it) and compiles every kernel again for each new one, seconds each time.
+  local_size_ = settings.local_size ? settings.local_size : 64;
+  features_ = settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene);
+  options_ = program_options(features_);
+  path_state_ = path_state_layout(wave_size_);
+
+  const PackedScene packed =
+      pack_scene(scene, bvh, pick_camera(scene, settings), settings.background);
+  desc_ = packed.desc;
+  const cl::Context& ctx = rt_.context();
+  try {
+    scene_buf_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, packed.bytes.size(),
+                            const_cast<unsigned char*>(packed.bytes.data()));
+    path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
+    queue_slots_ =
+        cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
+    counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
+    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, pixels * sizeof(dev::float4));
+    rt_.queue().enqueueFillBuffer(counters_, dev::uint(0), 0, WP_COUNTER_COUNT * sizeof(dev::uint));
+    rt_.queue().enqueueFillBuffer(film_, dev::float4{0, 0, 0, 0}, 0, pixels * sizeof(dev::float4));
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "allocating device memory on " + rt_.device().name);
+  }
+
+  program_ = rt_.build(program_source(), options_);
+  for (int i = 0; i < kStageCount; ++i) {
+    if (static_cast<Stage>(i) == Stage::kAccumulate)
+      accumulate_.emplace_back(program_, kStageNames[i]);
+    else
+      stage_kernels_.emplace_back(program_, kStageNames[i]);
+  }
+}
+
+void Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
+  if (items == 0) return;
+  const std::size_t local = local_size_;
+  const std::size_t global = local ? (items + local - 1) / local * local : items;
+  const cl::EnqueueArgs args(rt_.queue(), cl::NDRange(global),
+                             local ? cl::NDRange(local) : cl::NullRange);
+  cl::Event event;
+  try {
+    if (stage == Stage::kAccumulate)
+      event = accumulate_.front()(args, scene_buf_, desc_, path_buf_, path_state_.layout,
+                                  queue_slots_, counters_, params, film_);
+    else
+      event = stage_kernels_[static_cast<int>(stage)](
+          args, scene_buf_, desc_, path_buf_, path_state_.layout, queue_slots_, counters_, params);
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, std::string("launching ") + stage_name(stage));
+  }
+  if (settings_.profile) pending_events_.emplace_back(stage, event);
+}
+
+void Wavefront::reset_counters(std::uint32_t first, std::uint32_t count) {
+  rt_.queue().enqueueFillBuffer(counters_, dev::uint(0), first * sizeof(dev::uint),
+                                count * sizeof(dev::uint));
+}
+
+std::uint32_t Wavefront::read_counter(std::uint32_t index) {
+  dev::uint value = 0;
+  rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, index * sizeof(dev::uint), sizeof(value),
+                                &value);
+  return value;
+}
+
+void Wavefront::write_queue(dev::uint queue, const std::vector<dev::uint>& slots) {
+  if (slots.size() > wave_size_) throw Error("write_queue: more slots than the wave holds");
+  std::vector<dev::uint> counters(WP_QUEUE_COUNT, 0u);
+  counters[queue] = static_cast<dev::uint>(slots.size());
+  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
+                                 counters.data());
+  if (!slots.empty())
+    rt_.queue().enqueueWriteBuffer(queue_slots_, CL_TRUE, queue * wave_size_ * sizeof(dev::uint),
+                                   slots.size() * sizeof(dev::uint), slots.data());
+}
+
+dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_pixel,
+                                     std::uint32_t count) const {
+  dev::Launch p{};
+  p.width = static_cast<dev::uint>(settings_.width);
+  p.height = static_cast<dev::uint>(settings_.height);
+  p.pixel_offset = first_pixel;
+  p.path_count = count;
+  p.sample = sample;
+  p.seed = settings_.seed;
+  p.max_depth = static_cast<dev::uint>(settings_.max_depth);
+  p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
+  return p;
+}
+
+// One wave of paths through all bounces: the algorithm, one named call per stage.
+void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count) {
+  dev::Launch p = launch_params(sample, first_pixel, count);
+  p.queue_out = WP_QUEUE_RAY_A;
+  launch(Stage::kGenerateCameraRays, count, p);
+
+  std::uint32_t rays = count;
+  p.queue_in = WP_QUEUE_RAY_A;
+  p.queue_out = WP_QUEUE_RAY_B;
+  while (rays > 0) {
+    reset_counters(WP_QUEUE_SURFACE, 2);  // surface and shadow queues
+    reset_counters(p.queue_out, 1);
+    launch(Stage::kIntersectClosest, rays, p);
+    launch(Stage::kShadeSurface, rays, p);
+    launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
+    launch(Stage::kTraceShadow, rays, p);
+    launch(Stage::kSampleBsdf, rays, p);
+    launch(Stage::kRouletteCompact, rays, p);
+    rays = read_counter(p.queue_out);
+    std::swap(p.queue_in, p.queue_out);
+  }
+  launch(Stage::kAccumulate, count, p);
+}
+
+void Wavefront::render_pass(std::uint32_t sample) {
+  const std::uint32_t pixels = static_cast<std::uint32_t>(settings_.width * settings_.height);
+  try {
+    for (std::uint32_t first = 0; first < pixels; first += static_cast<std::uint32_t>(wave_size_))
+      run_wave(sample, first,
+               std::min<std::uint32_t>(static_cast<std::uint32_t>(wave_size_), pixels - first));
+    rt_.queue().finish();
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "rendering on " + rt_.device().name);
+  }
+  if (settings_.profile) collect_profile();
+}
+
+void Wavefront::collect_profile() {
+  for (auto& [stage, event] : pending_events_) {
+    const auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+    const auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+    times_.seconds[static_cast<int>(stage)] += static_cast<double>(end - start) * 1e-9;
+    times_.launches[static_cast<int>(stage)] += 1;
+  }
+  pending_events_.clear();
+}
+
+std::vector<float> Wavefront::image(std::uint32_t samples) {
+  const std::size_t pixels = std::size_t(settings_.width) * std::size_t(settings_.height);
+  std::vector<dev::float4> film(pixels);
+  rt_.queue().enqueueReadBuffer(film_, CL_TRUE, 0, pixels * sizeof(dev::float4), film.data());
+  std::vector<float> rgb(3 * pixels);
+  const float scale = samples ? 1.0f / static_cast<float>(samples) : 0.0f;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    rgb[3 * i + 0] = film[i].x * scale;
+    rgb[3 * i + 1] = film[i].y * scale;
+    rgb[3 * i + 2] = film[i].z * scale;
+  }
+  return rgb;
+}
+
+std::uint64_t Wavefront::nonfinite_samples() {
+  return read_counter(WP_COUNTER_NONFINITE);
+}
+
+}  // namespace wp

@@ -1,0 +1,119 @@
+// The wavefront path tracer on one OpenCL device: the scene and the path state in device buffers,
+// the program specialised to the scene's features, and the render loop over the stage kernels.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "bvh/bvh.h"
+#include "host/cl_runtime.h"
+#include "host/path_state.h"
+#include "host/scene.h"
+#include "host/scene_features.h"
+#include "host/stages.h"
+#include "kernels/shared/types.h"
+
+namespace wp {
+
+struct RenderSettings {
+  int width = 640;
+  int height = 480;
+  int spp = 64;        // samples per pixel
+  int max_depth = 12;  // scattering events per path at most
+  int rr_depth = 3;    // Russian roulette from this many scattering events on (>= max_depth: off)
+  std::uint32_t seed = 0;      // the image is a pure function of (scene, settings, seed)
+  glm::vec3 background{0.0f};  // radiance of escaped rays
+  int camera = -1;             // index into Scene::cameras; -1: the first, or a framing camera
+  bool all_features = false;   // build every kernel feature regardless of the scene
+  std::size_t wave_size = 0;   // path slots per wave; 0: min(pixels, 2^20)
+  std::size_t local_size = 0;  // work-group size; 0: 64
+  bool profile = false;        // time every kernel launch with profiling events
+};
+
+// Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
+struct StageTimes {
+  std::array<double, kStageCount> seconds{};
+  std::array<std::uint64_t, kStageCount> launches{};
+};
+
+class Wavefront {
+ public:
+  // Packs and uploads the scene, allocates the path state and builds the program. `bvh` must have
+  // been built over `scene`'s triangles.
+  Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+            const RenderSettings& settings);
+
+  // Renders sample index `sample` for every pixel and adds it to the film.
+  void render_pass(std::uint32_t sample);
+  // The film divided by `samples`: linear RGB, row by row from the top, 3 floats per pixel.
+  std::vector<float> image(std::uint32_t samples);
+  // Samples the film rejected because they were NaN or infinite.
+  std::uint64_t nonfinite_samples();
+
+  // Stage-level access for tests and benchmarks. Field offsets are those of path_state().layout,
+  // e.g. write_paths(path_state().layout.ray_o, rays).
+  void launch_stage(Stage stage, std::uint32_t items, const dev::Launch& params) {
+    launch(stage, items, params);
+  }
+  template <class T>
+  void write_paths(dev::uint field_offset, const std::vector<T>& values) {
+    rt_.queue().enqueueWriteBuffer(path_buf_, CL_TRUE, field_offset, values.size() * sizeof(T),
+                                   values.data());
+  }
+  template <class T>
+  std::vector<T> read_paths(dev::uint field_offset, std::size_t count) {
+    std::vector<T> values(count);
+    rt_.queue().enqueueReadBuffer(path_buf_, CL_TRUE, field_offset, count * sizeof(T),
+                                  values.data());
+    return values;
+  }
+  // Replaces queue `queue` (WP_QUEUE_*) with `slots` and sets its counter; zeroes the others.
+  void write_queue(dev::uint queue, const std::vector<dev::uint>& slots);
+  // Launch parameters of sample `sample` for the wave starting at `first_pixel`.
+  dev::Launch launch_params(std::uint32_t sample, std::uint32_t first_pixel,
+                            std::uint32_t count) const;
+  void finish() { rt_.queue().finish(); }
+
+  const SceneFeatures& features() const { return features_; }
+  const PathStateLayout& path_state() const { return path_state_; }
+  std::size_t wave_size() const { return wave_size_; }
+  const StageTimes& stage_times() const { return times_; }
+  std::string build_options() const { return options_; }
+
+ private:
+  void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count);
+  void launch(Stage stage, std::uint32_t items, const dev::Launch& params);
+  void reset_counters(std::uint32_t first, std::uint32_t count);
+  std::uint32_t read_counter(std::uint32_t index);
+  void collect_profile();
+
+  ClRuntime& rt_;
+  RenderSettings settings_;
+  SceneFeatures features_;
+  dev::SceneDesc desc_{};
+  PathStateLayout path_state_;
+  std::size_t wave_size_ = 0;
+  std::size_t local_size_ = 0;
+  std::string options_;
+
+  cl::Buffer scene_buf_, path_buf_, queue_slots_, counters_, film_;
+  cl::Program program_;
+  // Typed launches: every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h); accumulate adds
+  // the film.
+  using StageKernel = cl::KernelFunctor<cl::Buffer, dev::SceneDesc, cl::Buffer, dev::PathLayout,
+                                        cl::Buffer, cl::Buffer, dev::Launch>;
+  using AccumulateKernel =
+      cl::KernelFunctor<cl::Buffer, dev::SceneDesc, cl::Buffer, dev::PathLayout, cl::Buffer,
+                        cl::Buffer, dev::Launch, cl::Buffer>;
+  std::vector<StageKernel> stage_kernels_;  // indexed by Stage, all but kAccumulate
+  std::vector<AccumulateKernel> accumulate_;
+  std::vector<std::pair<Stage, cl::Event>> pending_events_;
+  StageTimes times_;
+};
+
+}  // namespace wp

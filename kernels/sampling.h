@@ -1,0 +1,74 @@
+/* Sampling routines and their densities. Every routine here has a chi-square test against its pdf
+ * (tests/test_sampling.cpp). Directions are in a local frame with the normal along +z. */
+#ifndef WP_SAMPLING_H
+#define WP_SAMPLING_H
+
+#include "common.h"
+
+/* Cosine-weighted hemisphere (concentric disk mapping, then lifted): pdf = cos(theta) / pi. */
+inline float3 sample_cosine_hemisphere(float2 u) {
+  const float2 s = 2.0f * u - 1.0f;
+  float r, phi;
+  if (s.x == 0.0f && s.y == 0.0f) return (float3)(0.0f, 0.0f, 1.0f);
+  if (fabs(s.x) > fabs(s.y)) {
+    r = s.x;
+    phi = (WP_PI / 4.0f) * (s.y / s.x);
+  } else {
+    r = s.y;
+    phi = (WP_PI / 2.0f) - (WP_PI / 4.0f) * (s.x / s.y);
+  }
+  const float x = r * cos(phi), y = r * sin(phi);
+  return (float3)(x, y, sqrt(fmax(0.0f, 1.0f - x * x - y * y)));
+}
+
+inline float cosine_hemisphere_pdf(float cos_theta) {
+  return fmax(cos_theta, 0.0f) * WP_INV_PI;
+}
+
+/* GGX (Trowbridge-Reitz) normal distribution D(h) for alpha = roughness^2, local frame. */
+inline float ggx_d(float n_dot_h, float alpha) {
+  const float a2 = alpha * alpha;
+  const float k = n_dot_h * n_dot_h * (a2 - 1.0f) + 1.0f;
+  return a2 / (WP_PI * k * k);
+}
+
+/* Smith G1 for GGX. */
+inline float ggx_g1(float n_dot_v, float alpha) {
+  const float a2 = alpha * alpha;
+  return 2.0f * n_dot_v / (n_dot_v + sqrt(a2 + (1.0f - a2) * n_dot_v * n_dot_v));
+}
+
+/* Height-correlated Smith visibility V = G2 / (4 |n.l| |n.v|) (glTF 2.0 appendix B). */
+inline float ggx_visibility(float n_dot_l, float n_dot_v, float alpha) {
+  const float a2 = alpha * alpha;
+  const float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
+  const float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
+  const float s = gv + gl;
+  return s > 0.0f ? 0.5f / s : 0.0f;
+}
+
+/* A microfacet normal h drawn from the distribution of normals visible from v (v.z > 0):
+ * density D_v(h) = G1(v) max(0, v.h) D(h) / v.z. Method: stretch v to the hemisphere
+ * configuration, sample the projected visible half-disk, unstretch (Heitz 2018). */
+inline float3 sample_ggx_visible_normal(float3 v, float alpha, float2 u) {
+  const float3 vh = normalize((float3)(alpha * v.x, alpha * v.y, v.z));
+  const float len2 = vh.x * vh.x + vh.y * vh.y;
+  const float3 t1 =
+      len2 > 0.0f ? (float3)(-vh.y, vh.x, 0.0f) * rsqrt(len2) : (float3)(1.0f, 0.0f, 0.0f);
+  const float3 t2 = cross(vh, t1);
+  const float r = sqrt(u.x);
+  const float phi = 2.0f * WP_PI * u.y;
+  const float p1 = r * cos(phi);
+  const float s = 0.5f * (1.0f + vh.z);
+  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * sin(phi);
+  const float3 nh = p1 * t1 + p2 * t2 + sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+  return normalize((float3)(alpha * nh.x, alpha * nh.y, fmax(1e-7f, nh.z)));
+}
+
+/* Density of the reflected direction l = reflect(v, h) when h is sampled as above:
+ * D_v(h) / (4 v.h) = G1(v) D(h) / (4 v.z). */
+inline float ggx_reflection_pdf(float n_dot_v, float n_dot_h, float alpha) {
+  return ggx_g1(n_dot_v, alpha) * ggx_d(n_dot_h, alpha) / (4.0f * n_dot_v);
+}
+
+#endif /* WP_SAMPLING_H */

@@ -1,0 +1,36 @@
+/* The surface record that shade_surface leaves in the path state for the stages after it. */
+#ifndef WP_SURFACE_H
+#define WP_SURFACE_H
+
+#include "bsdf.h"
+#include "path_state.h"
+#include "rng.h"
+
+inline void surface_store(Paths paths, uint slot, const Surface* s) {
+  paths.surf_p[slot] = (float4)(s->p, 0.0f);
+  paths.surf_ng[slot] = (float4)(s->ng, 0.0f);
+  paths.surf_ns[slot] = (float4)(s->ns, 0.0f);
+  paths.surf_color[slot] = (float4)(s->color, s->metallic);
+  paths.surf_params[slot] = (float4)(s->roughness, s->ior, s->transmission, 0.0f);
+}
+
+inline Surface surface_load(Paths paths, uint slot) {
+  Surface s;
+  s.p = paths.surf_p[slot].xyz;
+  s.ng = paths.surf_ng[slot].xyz;
+  s.ns = paths.surf_ns[slot].xyz;
+  const float4 c = paths.surf_color[slot];
+  const float4 q = paths.surf_params[slot];
+  s.color = c.xyz;
+  s.metallic = c.w;
+  s.roughness = q.x, s.ior = q.y, s.transmission = q.z;
+  return s;
+}
+
+/* The random numbers of the path in `slot` at its current bounce. */
+inline Rng path_rng(Paths paths, uint slot, Launch launch) {
+  const uint4 info = paths.info[slot];
+  return rng_make(info.x, launch.sample, launch.seed, info.y);
+}
+
+#endif /* WP_SURFACE_H */

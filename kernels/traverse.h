@@ -1,0 +1,134 @@
+/* Ray traversal of the flattened binary BVH (shared/bvh_layout.h): closest hit and any hit.
+ *
+ * The arithmetic is exactly that of the CPU reference (bvh/bvh_traverse.cpp), which the tests
+ * compare against Embree: slab test with clamped reciprocal directions, Moller-Trumbore written
+ * in scalar operations (on PoCL the float3 cross/dot builtins vectorise worse), nearer child
+ * first, leaves intersected as soon as they are reached.
+ */
+#ifndef WP_TRAVERSE_H
+#define WP_TRAVERSE_H
+
+#include "common.h"
+
+/* No fused multiply-adds here: the CPU reference is written without them, and with contraction
+ * the kernel's results differ from it in the last bits (and, measured on PoCL, some rays missed a
+ * triangle the reference and Embree both hit). Exact agreement makes the kernel testable. */
+#pragma OPENCL FP_CONTRACT OFF
+
+typedef struct TraceRay {
+  float ox, oy, oz;
+  float dx, dy, dz;
+  float ix, iy, iz; /* clamped reciprocal direction */
+  float tmin;
+} TraceRay;
+
+typedef struct TraceHit {
+  float t, u, v;
+  uint tri; /* scene triangle index; valid when t < the ray's tmax */
+} TraceHit;
+
+inline float safe_rcp(float d) {
+  return 1.0f / (fabs(d) > 1e-20f ? d : copysign(1e-20f, d));
+}
+
+inline TraceRay trace_ray(float3 o, float3 d, float tmin) {
+  TraceRay r;
+  r.ox = o.x, r.oy = o.y, r.oz = o.z;
+  r.dx = d.x, r.dy = d.y, r.dz = d.z;
+  r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
+  r.tmin = tmin;
+  return r;
+}
+
+/* Slab test of one box; returns the entry distance, or INFINITY when the box is missed within
+ * [tmin, tmax]. */
+inline float box_entry(const TraceRay* r, float lox, float hix, float loy, float hiy, float loz,
+                       float hiz, float tmax) {
+  const float tx0 = (lox - r->ox) * r->ix, tx1 = (hix - r->ox) * r->ix;
+  const float ty0 = (loy - r->oy) * r->iy, ty1 = (hiy - r->oy) * r->iy;
+  const float tz0 = (loz - r->oz) * r->iz, tz1 = (hiz - r->oz) * r->iz;
+  const float tnear = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), r->tmin));
+  const float tfar = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), tmax));
+  return tnear <= tfar ? tnear : INFINITY;
+}
+
+/* Moller-Trumbore against one stored triangle. On a hit closer than hit->t, updates *hit. */
+inline bool triangle_test(const TraceRay* r, __global const IsectTri* tri, TraceHit* hit) {
+  const float4 v0 = tri->v0, e1 = tri->e1, e2 = tri->e2;
+  const float px = r->dy * e2.z - r->dz * e2.y;
+  const float py = r->dz * e2.x - r->dx * e2.z;
+  const float pz = r->dx * e2.y - r->dy * e2.x;
+  const float det = e1.x * px + e1.y * py + e1.z * pz;
+  if (det == 0.0f) return false;
+  if ((as_uint(e1.w) & WP_TRI_CULL_BACKFACE) && det < 0.0f) return false;
+  const float inv = 1.0f / det;
+  const float sx = r->ox - v0.x, sy = r->oy - v0.y, sz = r->oz - v0.z;
+  const float u = (sx * px + sy * py + sz * pz) * inv;
+  if (u < 0.0f || u > 1.0f) return false;
+  const float qx = sy * e1.z - sz * e1.y;
+  const float qy = sz * e1.x - sx * e1.z;
+  const float qz = sx * e1.y - sy * e1.x;
+  const float v = (r->dx * qx + r->dy * qy + r->dz * qz) * inv;
+  if (v < 0.0f || u + v > 1.0f) return false;
+  const float t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv;
+  if (!(t > r->tmin && t < hit->t)) return false;
+  hit->t = t, hit->u = u, hit->v = v, hit->tri = as_uint(v0.w);
+  return true;
+}
+
+/* Intersects the leaf [first, first + count); with `any`, stops at the first hit. */
+inline bool leaf_test(const TraceRay* r, __global const IsectTri* tris, int ref, int count,
+                      TraceHit* hit, bool any) {
+  bool found = false;
+  __global const IsectTri* tri = tris + ~ref;
+  for (int i = 0; i < count; ++i) {
+    if (triangle_test(r, tri + i, hit)) {
+      found = true;
+      if (any) return true;
+    }
+  }
+  return found;
+}
+
+/* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
+ * hit; the hit record holds the closest one found. */
+inline bool bvh_trace(__global const BvhNode* nodes, __global const IsectTri* tris,
+                      const TraceRay* r, float tmax, TraceHit* hit, bool any) {
+  int stack[WP_BVH_STACK_SIZE];
+  int sp = 0;
+  int node = 0;
+  bool found = false;
+  hit->t = tmax;
+  for (;;) {
+    __global const BvhNode* n = nodes + node;
+    const float4 a = n->c0_xy, b = n->c1_xy, z = n->c01_z;
+    const int4 link = n->link;
+    float t0 = box_entry(r, a.x, a.y, a.z, a.w, z.x, z.y, hit->t);
+    float t1 = box_entry(r, b.x, b.y, b.z, b.w, z.z, z.w, hit->t);
+    if (t0 < INFINITY && link.x < 0) {
+      found |= leaf_test(r, tris, link.x, link.z, hit, any);
+      if (found && any) return true;
+      t0 = INFINITY;
+    }
+    if (t1 < INFINITY && link.y < 0) {
+      found |= leaf_test(r, tris, link.y, link.w, hit, any);
+      if (found && any) return true;
+      t1 = INFINITY;
+    }
+    if (t0 < INFINITY && t1 < INFINITY) {
+      const bool first0 = t0 <= t1;
+      stack[sp++] = first0 ? link.y : link.x;
+      node = first0 ? link.x : link.y;
+    } else if (t0 < INFINITY) {
+      node = link.x;
+    } else if (t1 < INFINITY) {
+      node = link.y;
+    } else {
+      if (sp == 0) break;
+      node = stack[--sp];
+    }
+  }
+  return found;
+}
+
+#endif /* WP_TRAVERSE_H */
