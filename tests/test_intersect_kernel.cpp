@@ -1,0 +1,289 @@
+// Tier 2: the ray-tracing stage kernels (intersect_closest, trace_shadow) against Embree's own
+// rtcIntersect1 / rtcOccluded1 on the same triangles, on PoCL.
+//
+// Expected agreement: the same hit/miss and the same triangle, t within 1e-4 relative plus the
+// rounding every float implementation has (t_rounding below). The only
+// tolerated differences are ties: a ray through a shared edge or vertex may report either
+// neighbour, as may a ray through coincident faces (either way both triangles are hit at the same
+// t, which is checked), and a ray grazing an edge may hit on one
+// side of the rounding and miss on the other (then the hit lies within 1e-4 of the triangle's
+// border in barycentric terms). Ties are counted and must stay below 1e-3 of the rays.
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "bvh/bvh.h"
+#include "host/cl_runtime.h"
+#include "host/gltf_loader.h"
+#include "host/wavefront.h"
+#include "tests/scene_factory.h"
+#include "tests/test_assets.h"
+
+namespace {
+
+using wp::dev::float4;
+
+constexpr std::uint32_t kWave = 1u << 16;
+
+struct EmbreeScene {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  explicit EmbreeScene(const wp::Scene& s) {
+    device = rtcNewDevice(nullptr);
+    scene = rtcNewScene(device);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), s.positions.size()));
+    for (std::size_t i = 0; i < s.positions.size(); ++i)
+      for (int k = 0; k < 3; ++k) v[3 * i + k] = s.positions[i][k];
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), s.triangle_count()));
+    std::copy(s.indices.begin(), s.indices.end(), idx);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(scene);
+  }
+  ~EmbreeScene() {
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  }
+};
+
+struct Rays {
+  std::vector<float4> o, d;  // o.w = tmin, d.w = tmax
+};
+
+// Camera-like rays from outside the bounds toward random points inside, and random rays from
+// random points inside the bounds in uniformly random directions.
+Rays make_rays(const wp::Scene& s, std::size_t count, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const glm::vec3 lo = s.bounds_lo, hi = s.bounds_hi, c = 0.5f * (lo + hi);
+  const float radius = 0.5f * glm::length(hi - lo) + 1e-3f;
+  const auto in_box = [&] { return lo + (hi - lo) * glm::vec3(u(rng), u(rng), u(rng)); };
+  const auto on_sphere = [&] {
+    const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng), r = std::sqrt(1 - z * z);
+    return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
+  };
+  Rays r;
+  const glm::vec3 eye = c + 2.5f * radius * on_sphere();
+  for (std::size_t i = 0; i < count; ++i) {
+    glm::vec3 o, d;
+    if (i % 2 == 0) {
+      o = eye;
+      d = glm::normalize(in_box() - eye);
+    } else {
+      o = in_box();
+      d = on_sphere();
+    }
+    r.o.push_back({o.x, o.y, o.z, 0.0f});
+    r.d.push_back({d.x, d.y, d.z, 1e30f});
+  }
+  return r;
+}
+
+// Rounding in t that no float implementation avoids: a distance computed from vertices of
+// magnitude ~ the scene size S carries an absolute error ~ 2^-20 S, magnified by 1/|cos| for a
+// ray at angle theta to the triangle's normal. Rays starting within ~1e-6 of a surface (random
+// origins do) or grazing it have t relative errors well above 1e-4 from this alone.
+float t_rounding(const wp::Scene& s, float cos_theta) {
+  const float size = glm::length(s.bounds_hi - s.bounds_lo);
+  return std::ldexp(size, -20) / std::max(cos_theta, 1e-3f);
+}
+
+// Border distance in barycentrics of the point where the ray crosses triangle `tri`'s plane.
+float border_distance(const wp::Scene& s, std::uint32_t tri, glm::vec3 o, glm::vec3 d) {
+  const glm::vec3 a = s.positions[s.indices[3 * tri]], b = s.positions[s.indices[3 * tri + 1]],
+                  c = s.positions[s.indices[3 * tri + 2]];
+  const glm::vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+  const float det = glm::dot(e1, p);
+  if (det == 0.0f) return 0.0f;
+  const glm::vec3 t = o - a;
+  const float uu = glm::dot(t, p) / det, vv = glm::dot(d, glm::cross(t, e1)) / det;
+  return std::min({std::fabs(uu), std::fabs(vv), std::fabs(1.0f - uu - vv)});
+}
+
+class IntersectKernel : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
+  static void TearDownTestSuite() {
+    delete runtime_;
+    runtime_ = nullptr;
+  }
+
+  // Traces `rays` through intersect_closest and compares with rtcIntersect1.
+  void check_closest(const wp::Scene& scene, const Rays& rays) {
+    const wp::bvh::Bvh bvh = build(scene);
+    wp::Wavefront wf(*runtime_, scene, bvh, settings());
+    EmbreeScene embree(scene);
+    std::size_t ties = 0, hits = 0;
+    for (std::size_t first = 0; first < rays.o.size(); first += kWave) {
+      const std::size_t n = std::min<std::size_t>(kWave, rays.o.size() - first);
+      const auto& layout = wf.path_state().layout;
+      wf.write_paths(layout.ray_o,
+                     std::vector<float4>(rays.o.begin() + first, rays.o.begin() + first + n));
+      wf.write_paths(layout.ray_d,
+                     std::vector<float4>(rays.d.begin() + first, rays.d.begin() + first + n));
+      wf.write_queue(WP_QUEUE_RAY_A, identity(n));
+      auto p = wf.launch_params(0, 0, static_cast<std::uint32_t>(n));
+      p.queue_in = WP_QUEUE_RAY_A;
+      wf.launch_stage(wp::Stage::kIntersectClosest, static_cast<std::uint32_t>(n), p);
+      const auto hit = wf.read_paths<float4>(layout.hit, n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const float4 o = rays.o[first + i], d = rays.d[first + i];
+        RTCRayHit rh{};
+        rh.ray = {o.x, o.y, o.z, o.w, d.x, d.y, d.z, 0.0f, d.w, ~0u, 0, 0};  // mask: all
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        rtcIntersect1(embree.scene, &ctx, &rh);
+        const bool ours = hit[i].x < INFINITY, theirs = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        std::uint32_t our_tri;
+        std::memcpy(&our_tri, &hit[i].w, 4);
+        const glm::vec3 go(o.x, o.y, o.z), gd(d.x, d.y, d.z);
+        hits += theirs;
+        if (ours != theirs) {
+          const std::uint32_t tri = ours ? our_tri : rh.hit.primID;
+          ASSERT_LT(border_distance(scene, tri, go, gd), 1e-4f)
+              << "hit/miss differs away from an edge, ray " << first + i;
+          ++ties;
+        } else if (ours) {
+          const glm::vec3 ng = glm::normalize(glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+          EXPECT_LE(std::fabs(hit[i].x - rh.ray.tfar),
+                    1e-4f * rh.ray.tfar + t_rounding(scene, std::fabs(glm::dot(ng, gd))))
+              << "ray " << first + i << ": t " << hit[i].x << " vs Embree's " << rh.ray.tfar;
+          // Another triangle at the same t (checked just above) is a tie: a shared edge or
+          // vertex, or coincident faces (the CornellBox asset's light lies on its ceiling).
+          ties += our_tri != rh.hit.primID;
+        }
+      }
+    }
+    EXPECT_LT(static_cast<double>(ties), 1e-3 * static_cast<double>(rays.o.size()));
+    EXPECT_GT(hits, rays.o.size() / 20) << "the rays should hit the mesh often";
+  }
+
+  // Shadow segments between random points; compares trace_shadow with rtcOccluded1.
+  void check_shadow(const wp::Scene& scene, std::size_t count, std::uint32_t seed) {
+    const wp::bvh::Bvh bvh = build(scene);
+    wp::Wavefront wf(*runtime_, scene, bvh, settings());
+    EmbreeScene embree(scene);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const auto in_box = [&] {
+      return scene.bounds_lo +
+             (scene.bounds_hi - scene.bounds_lo) * glm::vec3(u(rng), u(rng), u(rng));
+    };
+    std::size_t mismatches = 0, occluded = 0, total = 0;
+    for (std::size_t first = 0; first < count; first += kWave) {
+      const std::size_t n = std::min<std::size_t>(kWave, count - first);
+      std::vector<float4> so(n), sd(n), sl(n, float4{1, 0, 0, 0}), zero(n, float4{0, 0, 0, 0});
+      for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 a = in_box(), b = in_box(), d = glm::normalize(b - a);
+        so[i] = {a.x, a.y, a.z, glm::length(b - a)};
+        sd[i] = {d.x, d.y, d.z, 0.0f};
+      }
+      const auto& layout = wf.path_state().layout;
+      wf.write_paths(layout.shadow_o, so);
+      wf.write_paths(layout.shadow_d, sd);
+      wf.write_paths(layout.shadow_l, sl);
+      wf.write_paths(layout.radiance, zero);
+      wf.write_queue(WP_QUEUE_SHADOW, identity(n));
+      wf.launch_stage(wp::Stage::kTraceShadow, static_cast<std::uint32_t>(n),
+                      wf.launch_params(0, 0, static_cast<std::uint32_t>(n)));
+      const auto radiance = wf.read_paths<float4>(layout.radiance, n);
+      for (std::size_t i = 0; i < n; ++i) {
+        RTCRay ray{so[i].x, so[i].y, so[i].z, 0.0f, sd[i].x, sd[i].y,
+                   sd[i].z, 0.0f,    so[i].w, ~0u,  0,       0};
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        rtcOccluded1(embree.scene, &ctx, &ray);
+        const bool theirs = ray.tfar < 0.0f, ours = radiance[i].x == 0.0f;
+        occluded += theirs;
+        mismatches += ours != theirs;
+        ++total;
+      }
+    }
+    // Differences only at grazing ties, which are rare on random segments.
+    EXPECT_LT(static_cast<double>(mismatches), 1e-3 * static_cast<double>(total));
+    EXPECT_GT(occluded, total / 20);
+    EXPECT_LT(occluded, total - total / 20);
+  }
+
+  static wp::bvh::Bvh build(const wp::Scene& s) {
+    wp::bvh::BuildInput in;
+    in.positions = s.positions.data();
+    in.indices = s.indices.data();
+    in.triangle_count = s.triangle_count();
+    return wp::bvh::build(in);
+  }
+  static wp::RenderSettings settings() {
+    wp::RenderSettings s;
+    s.width = static_cast<int>(kWave);
+    s.height = 1;
+    return s;
+  }
+  static std::vector<wp::dev::uint> identity(std::size_t n) {
+    std::vector<wp::dev::uint> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<wp::dev::uint>(i);
+    return v;
+  }
+
+  static wp::ClRuntime* runtime_;
+};
+wp::ClRuntime* IntersectKernel::runtime_ = nullptr;
+
+wp::Scene one_material_scene() {
+  wp::Scene s;
+  s.materials.push_back(wp::test::diffuse_material(glm::vec3(0.5f)));
+  return s;
+}
+
+TEST_F(IntersectKernel, SphereMatchesEmbree) {
+  wp::Scene s = one_material_scene();
+  wp::test::add_sphere(s, {0, 0, 0}, 1.0f, 96, 192, 0);
+  wp::test::add_sphere(s, {0.7f, 0.2f, 0.1f}, 0.5f, 32, 64, 0);  // intersecting spheres
+  wp::test::finish_bounds(s);
+  check_closest(s, make_rays(s, 100000, 1));
+}
+
+TEST_F(IntersectKernel, RandomSoupMatchesEmbree) {
+  wp::Scene s = one_material_scene();
+  wp::test::add_random_soup(s, 50000, 0.05f, 7, 0);
+  wp::test::finish_bounds(s);
+  check_closest(s, make_rays(s, 100000, 2));
+}
+
+TEST_F(IntersectKernel, ShadowRaysMatchEmbree) {
+  wp::Scene s = one_material_scene();
+  wp::test::add_random_soup(s, 2000, 0.05f, 9, 0);
+  wp::test::add_sphere(s, {0.5f, 0.5f, 0.5f}, 0.3f, 48, 96, 0);
+  wp::test::finish_bounds(s);
+  check_shadow(s, 100000, 3);
+}
+
+// Real models, when ../shared/assets is there.
+class IntersectModel : public IntersectKernel, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(IntersectModel, MatchesEmbree) {
+  WP_REQUIRE_MODEL(path, GetParam());
+  const wp::Scene s = wp::load_gltf(path);
+  check_closest(s, make_rays(s, 100000, 5));
+  check_shadow(s, 50000, 6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Assets, IntersectModel,
+                         ::testing::Values("DamagedHelmet/DamagedHelmet.glb",
+                                           "FlightHelmet/FlightHelmet.gltf",
+                                           "CornellBox/CornellBox.glb"),
+                         [](const auto& param_info) {
+                           std::string n = param_info.param;
+                           return n.substr(0, n.find('/'));
+                         });
+
+}  // namespace

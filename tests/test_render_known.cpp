@@ -1,0 +1,338 @@
+// Tier 4: whole-pipeline renders with answers known in closed form, computed here, plus
+// determinism. All on the default OpenCL device (PoCL in CI).
+//
+// Every known-answer scene here has no randomness but the pixel jitter (box filter): one bounce
+// to a delta lobe or to punctual lights, the rest escaping to a constant background. So each
+// pixel's expectation is the average of a smooth function over the pixel's footprint, which the
+// test integrates on a 16x16 midpoint grid (its error is far below the tolerance for smooth
+// functions, so no scene here has an edge or a shadow boundary in view), and the
+// estimator's standard error is sigma_pixel / sqrt(spp), sigma_pixel the spread of that function
+// over the footprint. A pixel fails when it is more than 6 standard errors away (after adding
+// float rounding, 2e-5 relative, in quadrature); with ~9000 values and Gaussian errors the chance
+// of a false alarm is ~2e-5. Where the Monte Carlo error dominates, the mean of z^2 must also be
+// that of a chi-square variable with one degree of freedom: 1 +- 5 sqrt(2/N) (this catches a
+// wrong variance, i.e. correlated or non-uniform jitter, that a per-pixel bound would miss).
+#include <cmath>
+#include <cstring>
+#include <functional>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "host/cl_runtime.h"
+#include "host/device_scene.h"
+#include "host/render.h"
+#include "tests/scene_factory.h"
+
+namespace {
+
+using glm::dvec3;
+using glm::vec3;
+
+class RenderKnown : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
+  static void TearDownTestSuite() {
+    delete runtime_;
+    runtime_ = nullptr;
+  }
+  static wp::ClRuntime* runtime_;
+};
+wp::ClRuntime* RenderKnown::runtime_ = nullptr;
+
+constexpr int kWidth = 64, kHeight = 48, kSpp = 16;
+
+// The direction of the camera ray through image point (x, y) in pixels (y down), computed as the
+// kernel does (kernels/camera.h) but in double precision.
+dvec3 camera_dir(const wp::dev::Camera& c, double x, double y) {
+  const double nx = 2.0 * x / kWidth - 1.0, ny = 1.0 - 2.0 * y / kHeight;
+  const dvec3 f(c.forward.x, c.forward.y, c.forward.z), r(c.right.x, c.right.y, c.right.z),
+      u(c.up.x, c.up.y, c.up.z);
+  return glm::normalize(f + nx * r + ny * u);
+}
+
+// Mean and standard deviation of `value(dir)` over each pixel's footprint.
+struct PixelMoments {
+  std::vector<dvec3> mean, sigma;
+};
+PixelMoments integrate(const wp::dev::Camera& cam, const std::function<dvec3(dvec3)>& value) {
+  constexpr int kGrid = 16;
+  PixelMoments m;
+  for (int py = 0; py < kHeight; ++py)
+    for (int px = 0; px < kWidth; ++px) {
+      dvec3 s(0.0), s2(0.0);
+      for (int j = 0; j < kGrid; ++j)
+        for (int i = 0; i < kGrid; ++i) {
+          const dvec3 v = value(camera_dir(cam, px + (i + 0.5) / kGrid, py + (j + 0.5) / kGrid));
+          s += v;
+          s2 += v * v;
+        }
+      const dvec3 mean = s / double(kGrid * kGrid);
+      m.mean.push_back(mean);
+      m.sigma.push_back(glm::sqrt(glm::max(s2 / double(kGrid * kGrid) - mean * mean, dvec3(0.0))));
+    }
+  return m;
+}
+
+void expect_matches(const wp::Rendered& r, const PixelMoments& expected) {
+  EXPECT_EQ(r.report.nonfinite_samples, 0u);
+  double z2 = 0.0, worst = 0.0;
+  int n = 0;
+  for (std::size_t p = 0; p < expected.mean.size(); ++p)
+    for (int c = 0; c < 3; ++c) {
+      const double e = expected.mean[p][c], got = r.image.rgb[3 * p + c];
+      const double mc = expected.sigma[p][c] * expected.sigma[p][c] / kSpp;
+      const double rounding = (2e-5 * e) * (2e-5 * e) + 1e-14;
+      const double z = (got - e) / std::sqrt(mc + rounding);
+      worst = std::max(worst, std::fabs(z));
+      ASSERT_LT(std::fabs(z), 6.0) << "pixel " << p << " channel " << c << ": got " << got
+                                   << ", expected " << e << " +- " << std::sqrt(mc + rounding);
+      // The chi-square check only where the Monte Carlo error dominates the rounding floor
+      // (elsewhere z is mostly rounding, whose spread the floor overstates).
+      if (mc > 100.0 * rounding) {
+        z2 += z * z;
+        ++n;
+      }
+    }
+  if (n >= 100) {
+    EXPECT_NEAR(z2 / n, 1.0, 5.0 * std::sqrt(2.0 / n)) << n << " pixels, worst |z| " << worst;
+  }
+}
+
+// A 200 x 200 quad in the plane y = 0, front face up.
+wp::Scene plane_scene(const wp::Material& m) {
+  wp::Scene s;
+  s.materials.push_back(m);
+  wp::test::add_quad(s, {-100, 0, -100}, {-100, 0, 100}, {100, 0, 100}, {100, 0, -100}, 0);
+  wp::test::finish_bounds(s);
+  return s;
+}
+
+wp::RenderSettings settings_for(const wp::Scene& s, vec3 background) {
+  wp::RenderSettings st;
+  st.width = kWidth;
+  st.height = kHeight;
+  st.spp = kSpp;
+  st.background = background;
+  st.camera = 0;
+  (void)s;
+  return st;
+}
+
+// Where the ray from `eye` along d meets the plane y = 0, and whether that is on plane_scene's
+// quad (a ray that passes beyond its edge sees the background).
+bool plane_hit(vec3 eye, dvec3 d, dvec3* p) {
+  if (d.y >= 0.0) return false;
+  *p = dvec3(eye) + (-double(eye.y) / d.y) * d;
+  return std::fabs(p->x) <= 100.0 && std::fabs(p->z) <= 100.0;
+}
+
+// A smooth metal (roughness 0, base colour 0.5) under a white sky shows exactly the Schlick
+// Fresnel term of the metal: F = 0.5 + 0.5 (1 - cos theta)^5.
+TEST_F(RenderKnown, SmoothMetalShowsSchlickFresnel) {
+  wp::Material m;
+  m.base_color = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  m.metallic = 1.0f;
+  m.roughness = 0.0f;
+  wp::Scene s = plane_scene(m);
+  // Every pixel sees the plane, from cos(theta) = 0.17 (grazing) to 0.7: the quad's far edge,
+  // a discontinuity the test's integration grid would not resolve, stays out of view.
+  const vec3 eye(0.0f, 1.0f, 3.0f);
+  s.cameras.push_back(wp::test::look_at(eye, {0.0f, 0.0f, 1.0f}, 0.9f));
+  const wp::RenderSettings st = settings_for(s, vec3(1.0f));
+  const wp::dev::Camera cam = wp::device_camera(s.cameras[0], kWidth, kHeight);
+  const auto expected = integrate(cam, [&](dvec3 d) {
+    dvec3 p;
+    if (!plane_hit(eye, d, &p)) return dvec3(1.0);  // the sky itself
+    const double c = -d.y;
+    return dvec3(0.5 + 0.5 * std::pow(1.0 - c, 5.0));
+  });
+  expect_matches(wp::render(*runtime_, s, st), expected);
+}
+
+// The glTF metallic-roughness BRDF (specification appendix B), written independently of the
+// kernels, in double precision.
+dvec3 gltf_brdf(dvec3 n, dvec3 v, dvec3 l, dvec3 base, double metallic, double roughness) {
+  const double nl = glm::dot(n, l), nv = glm::dot(n, v);
+  if (nl <= 0 || nv <= 0) return dvec3(0.0);
+  const dvec3 h = glm::normalize(v + l);
+  const double vh = glm::dot(v, h), nh = glm::dot(n, h), a = roughness * roughness, a2 = a * a;
+  const double d = a2 / (M_PI * std::pow(nh * nh * (a2 - 1) + 1, 2));
+  const double vis =
+      0.5 / (nl * std::sqrt(nv * nv * (1 - a2) + a2) + nv * std::sqrt(nl * nl * (1 - a2) + a2));
+  const double fd = 0.04 + 0.96 * std::pow(1 - vh, 5);
+  const dvec3 fm = base + (dvec3(1.0) - base) * std::pow(1 - vh, 5);
+  const dvec3 dielectric = (1 - fd) * base / M_PI + dvec3(fd * d * vis);
+  const dvec3 metal = fm * d * vis;
+  return (1 - metallic) * dielectric + metallic * metal;
+}
+
+struct LightCase {
+  const char* name;
+  wp::PunctualLight light;
+  double metallic, roughness;
+};
+
+void PrintTo(const LightCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class RenderPunctual : public RenderKnown, public ::testing::WithParamInterface<LightCase> {};
+
+// A plane lit by one punctual light in a black world: each pixel is f * E cos(theta), with
+// E = I / d^2 (point, spot with the KHR falloff) or E (directional), and nothing else.
+TEST_P(RenderPunctual, PlaneShowsBrdfTimesIrradiance) {
+  const LightCase& lc = GetParam();
+  wp::Material m;
+  m.base_color = glm::vec4(0.8f, 0.6f, 0.4f, 1.0f);
+  m.metallic = static_cast<float>(lc.metallic);
+  m.roughness = static_cast<float>(lc.roughness);
+  wp::Scene s = plane_scene(m);
+  s.lights.push_back(lc.light);
+  const vec3 eye(0.0f, 2.0f, 4.0f);
+  s.cameras.push_back(wp::test::look_at(eye, {0.0f, 0.0f, 0.0f}, 0.8f));
+  const wp::RenderSettings st = settings_for(s, vec3(0.0f));
+  const wp::dev::Camera cam = wp::device_camera(s.cameras[0], kWidth, kHeight);
+  const wp::PunctualLight& L = lc.light;
+  const dvec3 base(0.8, 0.6, 0.4), n(0, 1, 0);
+  const auto expected = integrate(cam, [&](dvec3 d) {
+    dvec3 p;
+    if (!plane_hit(eye, d, &p)) return dvec3(0.0);
+    dvec3 wi, irradiance;
+    if (L.type == wp::LightType::kDirectional) {
+      wi = -glm::normalize(dvec3(L.direction));
+      irradiance = dvec3(L.intensity);
+    } else {
+      const dvec3 to = dvec3(L.position) - p;
+      wi = glm::normalize(to);
+      irradiance = dvec3(L.intensity) / glm::dot(to, to);
+      if (L.type == wp::LightType::kSpot) {
+        const double co = std::cos(L.outer_cone), ci = std::cos(L.inner_cone);
+        const double scale = 1.0 / std::max(0.001, ci - co);
+        const double cd = glm::dot(glm::normalize(dvec3(L.direction)), -wi);
+        const double att = std::clamp(cd * scale - co * scale, 0.0, 1.0);
+        irradiance *= att * att;
+      }
+    }
+    return gltf_brdf(n, -d, wi, base, lc.metallic, lc.roughness) * std::max(0.0, wi.y) * irradiance;
+  });
+  expect_matches(wp::render(*runtime_, s, st), expected);
+}
+
+wp::PunctualLight point_light() {
+  wp::PunctualLight l;
+  l.type = wp::LightType::kPoint;
+  l.position = {0.3f, 1.5f, 0.2f};
+  l.intensity = {3.0f, 2.0f, 1.0f};
+  return l;
+}
+wp::PunctualLight spot_light() {
+  wp::PunctualLight l = point_light();
+  l.type = wp::LightType::kSpot;
+  l.direction = glm::normalize(vec3(0.1f, -1.0f, 0.3f));
+  l.inner_cone = 0.2f;
+  l.outer_cone = 0.6f;
+  return l;
+}
+wp::PunctualLight sun_light() {
+  wp::PunctualLight l;
+  l.type = wp::LightType::kDirectional;
+  l.direction = glm::normalize(vec3(0.3f, -1.0f, -0.5f));
+  l.intensity = {1.5f, 1.0f, 0.5f};
+  return l;
+}
+
+INSTANTIATE_TEST_SUITE_P(Lights, RenderPunctual,
+                         ::testing::Values(LightCase{"PointDiffuse", point_light(), 0.0, 1.0},
+                                           LightCase{"PointGlossy", point_light(), 0.0, 0.4},
+                                           LightCase{"PointMetal", point_light(), 1.0, 0.5},
+                                           LightCase{"SpotDiffuse", spot_light(), 0.0, 1.0},
+                                           LightCase{"SunGlossy", sun_light(), 0.3, 0.6}),
+                         [](const auto& param_info) { return std::string(param_info.param.name); });
+
+// An emissive quad facing the camera shows its radiance; seen from behind it is not there when
+// single-sided (glTF back-face culling) and emits from both sides when double-sided.
+TEST_F(RenderKnown, EmissionAndSidedness) {
+  for (const bool double_sided : {false, true}) {
+    for (const bool from_front : {true, false}) {
+      wp::Material m = wp::test::diffuse_material(vec3(0.0f), double_sided);
+      m.emission = {2.0f, 3.0f, 4.0f};
+      wp::Scene s;
+      s.materials.push_back(m);
+      // Front faces +z.
+      wp::test::add_quad(s, {-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}, 0);
+      wp::test::finish_bounds(s);
+      s.cameras.push_back(wp::test::look_at({0, 0, from_front ? 3.0f : -3.0f}, {0, 0, 0}, 0.5f));
+      wp::RenderSettings st = settings_for(s, vec3(0.25f));
+      st.max_depth = 0;  // emission only: the quad's own reflection would add to it otherwise
+      const wp::Rendered r = wp::render(*runtime_, s, st);
+      const bool visible = from_front || double_sided;
+      const float want[3] = {visible ? 2.0f : 0.25f, visible ? 3.0f : 0.25f,
+                             visible ? 4.0f : 0.25f};
+      for (std::size_t p = 0; p < r.image.rgb.size() / 3; ++p)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(r.image.rgb[3 * p + c], want[c])
+              << "double_sided " << double_sided << " from_front " << from_front;
+    }
+  }
+}
+
+// A small closed scene with every kind of randomness: diffuse, glossy and mirror surfaces, a
+// point light, emission, roulette.
+wp::Scene busy_scene() {
+  wp::Scene s;
+  s.materials.push_back(wp::test::diffuse_material(vec3(0.7f, 0.6f, 0.5f)));
+  wp::Material glossy;
+  glossy.base_color = glm::vec4(0.9f, 0.5f, 0.2f, 1.0f);
+  glossy.metallic = 0.5f;
+  glossy.roughness = 0.3f;
+  s.materials.push_back(glossy);
+  wp::Material mirror;
+  mirror.metallic = 1.0f;
+  mirror.roughness = 0.0f;
+  s.materials.push_back(mirror);
+  wp::Material lamp = wp::test::diffuse_material(vec3(0.0f));
+  lamp.emission = {5.0f, 5.0f, 4.0f};
+  s.materials.push_back(lamp);
+  wp::test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+  wp::test::add_quad(s, {-2, 0, -2}, {2, 0, -2}, {2, 3, -2}, {-2, 3, -2}, 2);
+  wp::test::add_sphere(s, {0.5f, 0.6f, 0.0f}, 0.6f, 24, 48, 1);
+  wp::test::add_quad(s, {-0.5f, 2.5f, -0.5f}, {0.5f, 2.5f, -0.5f}, {0.5f, 2.5f, 0.5f},
+                     {-0.5f, 2.5f, 0.5f}, 3);
+  wp::PunctualLight l;
+  l.position = {-1.0f, 1.5f, 1.0f};
+  l.intensity = {2.0f, 2.0f, 2.0f};
+  s.lights.push_back(l);
+  wp::test::finish_bounds(s);
+  s.cameras.push_back(wp::test::look_at({0.0f, 1.5f, 5.0f}, {0.0f, 0.8f, 0.0f}, 0.9f));
+  return s;
+}
+
+// Same seed, same image, bit for bit, whatever the wave size and work-group size; another seed,
+// another image.
+TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
+  const wp::Scene s = busy_scene();
+  wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
+  st.spp = 4;
+  st.seed = 11;
+  const auto reference = wp::render(*runtime_, s, st).image.rgb;
+  double sum = 0.0;
+  for (float v : reference) sum += v;
+  EXPECT_GT(sum, 0.0);
+  for (const auto& [wave, local] : std::vector<std::pair<std::size_t, std::size_t>>{
+           {0, 0}, {1000, 0}, {777, 8}, {0, 64}, {256, 32}}) {
+    st.wave_size = wave;
+    st.local_size = local;
+    const auto image = wp::render(*runtime_, s, st).image.rgb;
+    ASSERT_EQ(image.size(), reference.size());
+    EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))
+        << "wave " << wave << " local " << local;
+  }
+  st.wave_size = 0;
+  st.local_size = 0;
+  st.seed = 12;
+  const auto other = wp::render(*runtime_, s, st).image.rgb;
+  EXPECT_NE(0, std::memcmp(other.data(), reference.data(), other.size() * sizeof(float)));
+}
+
+}  // namespace
