@@ -32,26 +32,52 @@ dev::uint append(std::vector<unsigned char>& bytes, const std::vector<T>& items)
 dev::Material device_material(const Material& m) {
   dev::Material d{};
   d.base_color = f4(m.base_color);
-  d.emission = f4(m.emission);
+  d.emission = f4(m.emission, m.alpha_cutoff);
   d.params = {m.metallic, m.roughness, m.ior, m.transmission};
-  d.flags = {m.double_sided ? WP_MAT_DOUBLE_SIDED : 0u, 0u, 0u, 0u};
+  d.volume =
+      f4(m.attenuation_color, m.attenuation_distance > 0.0f ? m.attenuation_distance : INFINITY);
+  d.extra = {m.normal_scale, m.thickness, 0.0f, 0.0f};
+  dev::uint flags = 0;
+  if (m.double_sided) flags |= WP_MAT_DOUBLE_SIDED;
+  if (m.alpha_mode == AlphaMode::kMask) flags |= WP_MAT_ALPHA_MASK;
+  if (m.alpha_mode == AlphaMode::kBlend) flags |= WP_MAT_ALPHA_BLEND;
+  if (m.unlit) flags |= WP_MAT_UNLIT;
+  if (m.thickness > 0.0f) flags |= WP_MAT_VOLUME;
+  d.flags = {flags, 0u, 0u, 0u};
+  d.textures0 = {m.base_color_texture, m.metallic_roughness_texture, m.normal_texture,
+                 m.emissive_texture};
+  d.textures1 = {m.transmission_texture, -1, -1, -1};
   return d;
 }
 
-dev::PunctualLight device_light(const PunctualLight& l) {
-  dev::PunctualLight d{};
-  d.position = f4(l.position, l.range);
-  d.direction = f4(glm::normalize(l.direction));
-  d.intensity = f4(l.intensity);
-  // KHR_lights_punctual's recommended spot falloff: saturate(cd * scale + offset)^2.
-  const float cos_outer = std::cos(l.outer_cone), cos_inner = std::cos(l.inner_cone);
-  const float scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
-  d.spot = {scale, -cos_outer * scale, 0.0f, 0.0f};
-  const dev::uint type = l.type == LightType::kPoint  ? WP_LIGHT_POINT
-                         : l.type == LightType::kSpot ? WP_LIGHT_SPOT
-                                                      : WP_LIGHT_DIRECTIONAL;
-  d.meta = {type, 0u, 0u, 0u};
+dev::uint wrap_bits(Wrap w) {
+  return w == Wrap::kRepeat        ? WP_WRAP_REPEAT
+         : w == Wrap::kClampToEdge ? WP_WRAP_CLAMP
+                                   : WP_WRAP_MIRROR;
+}
+
+dev::TextureRef device_texture(const TextureRef& t) {
+  dev::TextureRef d{};
+  d.transform_u = f4(t.row_u);
+  d.transform_v = f4(t.row_v);
+  dev::uint bits = wrap_bits(t.wrap_s) | (wrap_bits(t.wrap_t) << 8);
+  if (t.nearest) bits |= WP_TEX_NEAREST;
+  if (t.srgb) bits |= WP_TEX_SRGB;
+  d.meta = {static_cast<dev::uint>(t.image), bits, static_cast<dev::uint>(t.texcoord), 0u};
   return d;
+}
+
+// All images' texels in one array, RGBA8 with R in the lowest byte.
+void pack_images(const Scene& scene, std::vector<dev::TextureImage>& images,
+                 std::vector<dev::uint>& texels) {
+  for (const Image& img : scene.images) {
+    const std::size_t n = std::size_t(img.width) * std::size_t(img.height);
+    images.push_back({static_cast<dev::uint>(texels.size()), static_cast<dev::uint>(img.width),
+                      static_cast<dev::uint>(img.height), 0u});
+    for (std::size_t i = 0; i < n; ++i)
+      texels.push_back(dev::uint(img.rgba[4 * i]) | dev::uint(img.rgba[4 * i + 1]) << 8 |
+                       dev::uint(img.rgba[4 * i + 2]) << 16 | dev::uint(img.rgba[4 * i + 3]) << 24);
+  }
 }
 
 }  // namespace
@@ -79,42 +105,63 @@ dev::Camera device_camera(const Camera& c, int width, int height) {
   return d;
 }
 
-PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const dev::Camera& camera,
-                       glm::vec3 background) {
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x) {
   const std::size_t tris = scene.triangle_count();
   const std::size_t verts = scene.positions.size();
   std::vector<dev::uint4> tri_vertices(tris);
   for (std::size_t i = 0; i < tris; ++i)
     tri_vertices[i] = {scene.indices[3 * i], scene.indices[3 * i + 1], scene.indices[3 * i + 2],
                        scene.triangle_material[i]};
-  std::vector<dev::float4> positions(verts), normals(verts), uvs(verts), colors(verts);
+  std::vector<dev::float4> positions(verts), normals(verts), tangents(verts), uvs(verts),
+      colors(verts);
   for (std::size_t i = 0; i < verts; ++i) {
     positions[i] = f4(scene.positions[i]);
     normals[i] = f4(scene.normals[i]);
-    const glm::vec2 uv = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
-    uvs[i] = {uv.x, uv.y, 0.0f, 0.0f};
+    tangents[i] = i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
+    const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
+    const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
+    uvs[i] = {uv0.x, uv0.y, uv1.x, uv1.y};
     colors[i] = i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
   }
   std::vector<dev::Material> materials;
   for (const Material& m : scene.materials) materials.push_back(device_material(m));
-  std::vector<dev::PunctualLight> lights;
-  for (const PunctualLight& l : scene.lights) lights.push_back(device_light(l));
+  std::vector<dev::TextureRef> textures;
+  for (const TextureRef& t : scene.textures) textures.push_back(device_texture(t));
+  std::vector<dev::TextureImage> images;
+  std::vector<dev::uint> texels;
+  pack_images(scene, images, texels);
 
   PackedScene p;
   dev::SceneDesc& d = p.desc;
-  d.camera = camera;
-  d.background = f4(background);
+  d.camera = x.camera;
+  d.background = f4(x.background);
+  const float rotation = x.env_rotation_degrees * 3.14159265358979f / 180.0f;
+  d.env_params = {x.env_intensity, std::cos(rotation), std::sin(rotation), 0.0f};
   d.bvh_nodes = append(p.bytes, bvh.nodes);
   d.isect_tris = append(p.bytes, bvh.triangles);
   d.tri_vertices = append(p.bytes, tri_vertices);
   d.positions = append(p.bytes, positions);
   d.normals = append(p.bytes, normals);
+  d.tangents = append(p.bytes, tangents);
   d.uvs = append(p.bytes, uvs);
   d.colors = append(p.bytes, colors);
   d.materials = append(p.bytes, materials);
-  d.lights = append(p.bytes, lights);
-  d.light_count = static_cast<dev::uint>(lights.size());
+  d.textures = append(p.bytes, textures);
+  d.images = append(p.bytes, images);
+  d.texels = append(p.bytes, texels);
+  d.lights = append(p.bytes, x.lights->lights);
+  d.light_alias = append(p.bytes, x.lights->alias);
+  d.tri_light = append(p.bytes, x.lights->tri_light);
+  d.light_count = static_cast<dev::uint>(x.lights->lights.size());
+  d.env_light = x.lights->env_light;
   d.triangle_count = static_cast<dev::uint>(tris);
+  if (x.env) {
+    d.env_texels = append(p.bytes, x.env->texels);
+    d.env_marginal = append(p.bytes, x.env->marginal);
+    d.env_conditional = append(p.bytes, x.env->conditional);
+    d.env_width = static_cast<dev::uint>(x.env->width);
+    d.env_height = static_cast<dev::uint>(x.env->height);
+  }
   return p;
 }
 

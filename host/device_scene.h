@@ -7,6 +7,8 @@
 #include <glm/vec3.hpp>
 
 #include "bvh/bvh.h"
+#include "host/environment.h"
+#include "host/light_table.h"
 #include "host/scene.h"
 #include "kernels/shared/types.h"
 
@@ -23,7 +25,16 @@ struct PackedScene {
 // ymag * aspect and ymag (likewise, the image's aspect decides the horizontal extent).
 dev::Camera device_camera(const Camera& camera, int width, int height);
 
-PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const dev::Camera& camera,
-                       glm::vec3 background);
+// Everything about the render that is not in Scene: the camera, what escaped rays see, the lights.
+struct SceneExtras {
+  dev::Camera camera{};
+  glm::vec3 background{0.0f};           // constant radiance without a map
+  const EnvironmentMap* env = nullptr;  // may be null
+  float env_intensity = 1.0f;
+  float env_rotation_degrees = 0.0f;
+  const LightTable* lights = nullptr;  // required
+};
+
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& extras);
 
 }  // namespace wp

@@ -36,8 +36,11 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   input.indices = scene.indices.data();
   input.triangle_count = scene.triangle_count();
   std::vector<std::uint32_t> flags(scene.triangle_count());
-  for (std::size_t i = 0; i < flags.size(); ++i)
-    flags[i] = scene.materials[scene.triangle_material[i]].double_sided ? 0u : WP_TRI_CULL_BACKFACE;
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    const Material& m = scene.materials[scene.triangle_material[i]];
+    flags[i] = (m.double_sided ? 0u : WP_TRI_CULL_BACKFACE) |
+               (m.alpha_mode != AlphaMode::kOpaque ? WP_TRI_ALPHA : 0u);
+  }
   input.triangle_flags = flags.data();
   const bvh::Bvh bvh = bvh::build(input, options.bvh);
 

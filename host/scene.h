@@ -25,6 +25,26 @@ namespace wp {
 
 enum class AlphaMode : std::uint8_t { kOpaque, kMask, kBlend };
 
+enum class Wrap : std::uint8_t { kRepeat, kClampToEdge, kMirroredRepeat };
+
+// A decoded image, 8-bit RGBA, row by row from the top (uv (0,0) is the top-left corner).
+struct Image {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // 4 x width x height
+};
+
+// A material's use of an image: glTF textureInfo + sampler + KHR_texture_transform.
+struct TextureRef {
+  int image = -1;  // index into Scene::images
+  Wrap wrap_s = Wrap::kRepeat, wrap_t = Wrap::kRepeat;
+  bool nearest = false;  // magFilter NEAREST; otherwise bilinear
+  bool srgb = false;     // colour data (base colour, emissive): decode sRGB to linear
+  int texcoord = 0;      // TEXCOORD_0 or TEXCOORD_1
+  // KHR_texture_transform as a 2x3 matrix: (u', v') = (row_u . (u, v, 1), row_v . (u, v, 1)).
+  glm::vec3 row_u{1.0f, 0.0f, 0.0f}, row_v{0.0f, 1.0f, 0.0f};
+};
+
 struct Material {
   std::string name;
   glm::vec4 base_color{1.0f};  // baseColorFactor, linear RGB + alpha
@@ -36,6 +56,19 @@ struct Material {
   float alpha_cutoff = 0.5f;
   float ior = 1.5f;           // KHR_materials_ior
   float transmission = 0.0f;  // KHR_materials_transmission factor
+  bool unlit = false;         // KHR_materials_unlit
+  // KHR_materials_volume: with thickness > 0 the surface bounds a volume (refraction bends rays,
+  // the inside absorbs); without it a transmissive surface is thin-walled.
+  float thickness = 0.0f;
+  glm::vec3 attenuation_color{1.0f};
+  float attenuation_distance = 0.0f;  // 0: infinite (no absorption)
+  float normal_scale = 1.0f;
+  // Indices into Scene::textures, -1 for none.
+  int base_color_texture = -1;
+  int metallic_roughness_texture = -1;  // G: roughness, B: metallic
+  int normal_texture = -1;
+  int emissive_texture = -1;
+  int transmission_texture = -1;  // R: transmission
 };
 
 enum class LightType : std::uint8_t { kPoint, kSpot, kDirectional };
@@ -73,13 +106,17 @@ struct Scene {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uv0;
+  std::vector<glm::vec2> uv1;  // TEXCOORD_1 or (0,0); may be empty when no material uses it
   std::vector<glm::vec4> color0;
+  std::vector<glm::vec4> tangents;  // xyz unit, w handedness; supplied or generated; may be empty
 
   // Triangles: three vertex indices each (counter-clockwise front), and a material index.
   std::vector<std::uint32_t> indices;            // 3 x triangle_count()
   std::vector<std::uint32_t> triangle_material;  // triangle_count()
 
   std::vector<Material> materials;  // never empty: the loader adds glTF's default material if used
+  std::vector<Image> images;
+  std::vector<TextureRef> textures;
   std::vector<PunctualLight> lights;
   std::vector<Camera> cameras;  // in node order (depth-first over the default scene)
 

@@ -4,17 +4,35 @@
 
 namespace wp {
 
-SceneFeatures SceneFeatures::of(const Scene& scene) {
+namespace {
+template <class C, class P>
+bool any(const C& c, P p) {
+  return std::any_of(c.begin(), c.end(), p);
+}
+}  // namespace
+
+SceneFeatures SceneFeatures::of(const Scene& scene, bool has_environment_map) {
+  const auto& m = scene.materials;
   SceneFeatures f;
   f.punctual_lights = !scene.lights.empty();
-  f.spot_lights = std::any_of(scene.lights.begin(), scene.lights.end(),
-                              [](const PunctualLight& l) { return l.type == LightType::kSpot; });
-  f.emission = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
-    return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f;
+  f.spot_lights =
+      any(scene.lights, [](const PunctualLight& l) { return l.type == LightType::kSpot; });
+  f.emission = any(m, [](const Material& x) {
+    return x.emission.x > 0.0f || x.emission.y > 0.0f || x.emission.z > 0.0f;
   });
-  f.vertex_colors = std::any_of(scene.color0.begin(), scene.color0.end(), [](const glm::vec4& c) {
-    return c.r != 1.0f || c.g != 1.0f || c.b != 1.0f;
+  f.environment = has_environment_map;
+  f.vertex_colors = any(
+      scene.color0, [](const glm::vec4& c) { return c.r != 1.0f || c.g != 1.0f || c.b != 1.0f; });
+  f.textures = any(m, [](const Material& x) {
+    return x.base_color_texture >= 0 || x.metallic_roughness_texture >= 0 ||
+           x.normal_texture >= 0 || x.emissive_texture >= 0 || x.transmission_texture >= 0;
   });
+  f.normal_maps = any(m, [](const Material& x) { return x.normal_texture >= 0; });
+  f.alpha = any(m, [](const Material& x) { return x.alpha_mode != AlphaMode::kOpaque; });
+  f.unlit = any(m, [](const Material& x) { return x.unlit; });
+  f.transmission = any(
+      m, [](const Material& x) { return x.transmission > 0.0f || x.transmission_texture >= 0; });
+  f.volume = f.transmission && any(m, [](const Material& x) { return x.thickness > 0.0f; });
   return f;
 }
 
@@ -22,7 +40,14 @@ std::vector<std::pair<std::string, bool>> SceneFeatures::flags() const {
   return {{"WP_FEATURE_PUNCTUAL_LIGHTS", punctual_lights},
           {"WP_FEATURE_SPOT_LIGHTS", spot_lights},
           {"WP_FEATURE_EMISSION", emission},
-          {"WP_FEATURE_VERTEX_COLORS", vertex_colors}};
+          {"WP_FEATURE_ENVIRONMENT", environment},
+          {"WP_FEATURE_VERTEX_COLORS", vertex_colors},
+          {"WP_FEATURE_TEXTURES", textures},
+          {"WP_FEATURE_NORMAL_MAPS", normal_maps},
+          {"WP_FEATURE_ALPHA", alpha},
+          {"WP_FEATURE_UNLIT", unlit},
+          {"WP_FEATURE_TRANSMISSION", transmission},
+          {"WP_FEATURE_VOLUME", volume}};
 }
 
 std::string SceneFeatures::describe() const {

@@ -14,10 +14,18 @@ struct SceneFeatures {
   bool punctual_lights = true;
   bool spot_lights = true;
   bool emission = true;
+  bool environment = true;  // an environment map (not the constant background)
   bool vertex_colors = true;
+  bool textures = true;
+  bool normal_maps = true;
+  bool alpha = true;
+  bool unlit = true;
+  bool transmission = true;
+  bool volume = true;
 
   static SceneFeatures all() { return {}; }
-  static SceneFeatures of(const Scene& scene);
+  // The features `scene` uses; `has_environment_map` tells whether the render has a map.
+  static SceneFeatures of(const Scene& scene, bool has_environment_map);
 
   // (macro name, enabled) in a fixed order; drives the build options and the report.
   std::vector<std::pair<std::string, bool>> flags() const;

@@ -11,10 +11,13 @@ namespace wp {
 
 namespace {
 
-// The one place where program build options are assembled.
-std::string program_options(const SceneFeatures& features) {
+// The one place where program build options are assembled: the scene's features and the
+// settings that are compile-time constants of the kernels.
+std::string program_options(const SceneFeatures& features, const RenderSettings& s) {
   std::string o = "-cl-std=CL1.2";
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
+  o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
+  o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
   return o;
 }
 
@@ -46,12 +49,22 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
   // of it) and compiles every kernel again for each new one, seconds each time.
   local_size_ = settings.local_size ? settings.local_size : 64;
-  features_ = settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene);
-  options_ = program_options(features_);
+  const EnvironmentMap* env = settings.environment.get();
+  features_ =
+      settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
+  options_ = program_options(features_, settings);
   path_state_ = path_state_layout(wave_size_);
+  lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
+                              settings.light_select);
 
-  const PackedScene packed =
-      pack_scene(scene, bvh, pick_camera(scene, settings), settings.background);
+  SceneExtras extras;
+  extras.camera = pick_camera(scene, settings);
+  extras.background = settings.background;
+  extras.env = env;
+  extras.env_intensity = settings.env_intensity;
+  extras.env_rotation_degrees = settings.env_rotation;
+  extras.lights = &lights_;
+  const PackedScene packed = pack_scene(scene, bvh, extras);
   desc_ = packed.desc;
   const cl::Context& ctx = rt_.context();
   try {

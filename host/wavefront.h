@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,8 @@
 
 #include "bvh/bvh.h"
 #include "host/cl_runtime.h"
+#include "host/environment.h"
+#include "host/light_table.h"
 #include "host/path_state.h"
 #include "host/scene.h"
 #include "host/scene_features.h"
@@ -20,6 +23,9 @@
 
 namespace wp {
 
+enum class Strategy { kMis, kNee, kBsdf };
+enum class MisHeuristic { kPower, kBalance };
+
 struct RenderSettings {
   int width = 640;
   int height = 480;
@@ -27,7 +33,13 @@ struct RenderSettings {
   int max_depth = 12;  // scattering events per path at most
   int rr_depth = 3;    // Russian roulette from this many scattering events on (>= max_depth: off)
   std::uint32_t seed = 0;      // the image is a pure function of (scene, settings, seed)
-  glm::vec3 background{0.0f};  // radiance of escaped rays
+  glm::vec3 background{0.0f};  // radiance of escaped rays when there is no environment map
+  std::shared_ptr<const EnvironmentMap> environment;  // optional
+  float env_intensity = 1.0f;                         // scales the map
+  float env_rotation = 0.0f;                          // degrees about +Y
+  Strategy strategy = Strategy::kMis;
+  MisHeuristic mis_heuristic = MisHeuristic::kPower;
+  LightSelect light_select = LightSelect::kPower;
   int camera = -1;             // index into Scene::cameras; -1: the first, or a framing camera
   bool all_features = false;   // build every kernel feature regardless of the scene
   std::size_t wave_size = 0;   // path slots per wave; 0: min(pixels, 2^20)
@@ -80,6 +92,7 @@ class Wavefront {
   void finish() { rt_.queue().finish(); }
 
   const SceneFeatures& features() const { return features_; }
+  const LightTable& lights() const { return lights_; }
   const PathStateLayout& path_state() const { return path_state_; }
   std::size_t wave_size() const { return wave_size_; }
   const StageTimes& stage_times() const { return times_; }
@@ -95,6 +108,7 @@ class Wavefront {
   ClRuntime& rt_;
   RenderSettings settings_;
   SceneFeatures features_;
+  LightTable lights_;
   dev::SceneDesc desc_{};
   PathStateLayout path_state_;
   std::size_t wave_size_ = 0;

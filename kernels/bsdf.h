@@ -57,6 +57,10 @@ inline float3 schlick3(float3 f0, float c) {
 inline bool bsdf_has_delta(const Surface* s) {
   return s->roughness <= WP_DELTA_ROUGHNESS;
 }
+/* Nothing but delta lobes: light sampling cannot contribute (bsdf_eval is 0 everywhere). */
+inline bool bsdf_only_delta(const Surface* s) {
+  return bsdf_has_delta(s) && s->metallic >= 1.0f;
+}
 
 /* Fresnel-weighted reflectance of the specular layer where the microfacet normal is h. */
 inline float3 specular_fresnel(const Surface* s, float v_dot_h) {

@@ -1,20 +1,54 @@
-/* Scene features the program is specialised for. The host derives them from the scene
+/* What the program is specialised for. The host derives the WP_FEATURE_* set from the scene
  * (host/scene_features.cpp) and passes each as -D WP_FEATURE_X=0|1, so code for what a scene does
- * not use is not compiled at all. A feature left undefined is on: the all-features build. */
+ * not use is not compiled at all; the render settings below are -D options too. Anything left
+ * undefined takes its default: every feature on (the all-features build), full MIS. */
 #ifndef WP_FEATURES_H
 #define WP_FEATURES_H
 
 #ifndef WP_FEATURE_PUNCTUAL_LIGHTS
-#define WP_FEATURE_PUNCTUAL_LIGHTS 1 /* point, spot or directional lights (NEE) */
+#define WP_FEATURE_PUNCTUAL_LIGHTS 1 /* point, spot or directional lights */
 #endif
 #ifndef WP_FEATURE_SPOT_LIGHTS
 #define WP_FEATURE_SPOT_LIGHTS 1 /* spot cone falloff */
 #endif
 #ifndef WP_FEATURE_EMISSION
-#define WP_FEATURE_EMISSION 1 /* emissive triangles */
+#define WP_FEATURE_EMISSION 1 /* emissive triangles: emission at hits, area-light NEE */
+#endif
+#ifndef WP_FEATURE_ENVIRONMENT
+#define WP_FEATURE_ENVIRONMENT 1 /* an environment map (else a constant background) */
 #endif
 #ifndef WP_FEATURE_VERTEX_COLORS
 #define WP_FEATURE_VERTEX_COLORS 1 /* COLOR_0 multiplies the base colour */
+#endif
+#ifndef WP_FEATURE_TEXTURES
+#define WP_FEATURE_TEXTURES 1 /* any material texture */
+#endif
+#ifndef WP_FEATURE_NORMAL_MAPS
+#define WP_FEATURE_NORMAL_MAPS 1 /* tangent-space normal textures */
+#endif
+#ifndef WP_FEATURE_ALPHA
+#define WP_FEATURE_ALPHA 1 /* alphaMode MASK or BLEND */
+#endif
+#ifndef WP_FEATURE_UNLIT
+#define WP_FEATURE_UNLIT 1 /* KHR_materials_unlit */
+#endif
+#ifndef WP_FEATURE_TRANSMISSION
+#define WP_FEATURE_TRANSMISSION 1 /* KHR_materials_transmission */
+#endif
+#ifndef WP_FEATURE_VOLUME
+#define WP_FEATURE_VOLUME 1 /* KHR_materials_volume: refraction and absorption */
+#endif
+
+/* Sampling strategy for direct light: full MIS of NEE and BSDF sampling, NEE only, BSDF only. */
+#define WP_STRATEGY_MIS 0
+#define WP_STRATEGY_NEE 1
+#define WP_STRATEGY_BSDF 2
+#ifndef WP_STRATEGY
+#define WP_STRATEGY WP_STRATEGY_MIS
+#endif
+/* MIS heuristic: 1 power (beta = 2), 0 balance. */
+#ifndef WP_MIS_POWER
+#define WP_MIS_POWER 1
 #endif
 
 #endif /* WP_FEATURES_H */

@@ -10,9 +10,10 @@ __kernel void intersect_closest(WP_STAGE_PARAMS) {
   uint slot;
   if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
   const float4 o = paths.ray_o[slot], d = paths.ray_d[slot];
-  const TraceRay ray = trace_ray(o.xyz, d.xyz, o.w);
+  const uint key = rng_bits(path_rng(paths, slot, launch), WP_DIM_ALPHA_CLOSEST);
+  const TraceRay ray = trace_ray(o.xyz, d.xyz, o.w, key);
   TraceHit hit;
-  if (bvh_trace(scene.nodes, scene.tris, &ray, d.w, &hit, false))
+  if (bvh_trace(&scene, &ray, d.w, &hit, false))
     paths.hit[slot] = (float4)(hit.t, hit.u, hit.v, as_float(hit.tri));
   else
     paths.hit[slot] = (float4)(INFINITY, 0.0f, 0.0f, 0.0f);

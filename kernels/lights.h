@@ -1,16 +1,42 @@
-/* Punctual lights (KHR_lights_punctual): point, spot and directional, all delta distributions.
- * Units: a point/spot intensity is radiant intensity in W/sr, so the irradiance it gives a
- * surface facing it at distance d is I / d^2; a directional light's is irradiance in W/m^2. */
+/* Light sampling for next-event estimation, and the densities MIS needs for lights that BSDF
+ * sampling found.
+ *
+ * Level 1: one light per shading point from the alias table (host/light_table.h documents the
+ * uniform and power-proportional probabilities). Then, per light:
+ * - punctual (KHR_lights_punctual), delta distributions: a point/spot intensity is radiant
+ *   intensity in W/sr, giving irradiance I / d^2 (spot: times the recommended cone falloff); a
+ *   directional light's intensity is irradiance in W/m^2;
+ * - emissive triangle: a point uniform in its area, pdf 1/A converted to solid angle,
+ *   d^2 / (A |cos theta_light|). The emitting side follows the glTF winding: the front face emits,
+ *   the back face only when the material is double-sided (the same rule shade_surface applies to
+ *   hits);
+ * - environment: environment.h's sampling, pdf in solid angle.
+ * The returned pdf includes the light-choice probability. */
 #ifndef WP_LIGHTS_H
 #define WP_LIGHTS_H
 
 #include "common.h"
+#include "environment.h"
+#include "material.h"
 
 typedef struct LightSample {
   float3 wi;  /* unit direction from the shading point toward the light */
-  float dist; /* distance to the light (INFINITY for a directional light) */
-  float3 li;  /* irradiance at the point on a surface facing the light (before the cosine) */
+  float dist; /* distance to the light point (INFINITY for directional and environment) */
+  float3 li;  /* arriving radiance (area, environment) or irradiance (delta lights), before the
+                 cosine at the receiver and not divided by the pdf */
+  float pdf;  /* solid-angle pdf incl. the light choice; for delta lights the choice pmf alone */
+  bool delta; /* a delta light: no BSDF sample can find it (MIS weight 1) */
 } LightSample;
+
+inline uint pick_light(const SceneView* scene, float u, float* pmf) {
+  const uint n = scene->desc->light_count;
+  const float x = u * (float)n;
+  const uint i = min((uint)x, n - 1u);
+  const LightAlias e = scene->light_alias[i];
+  const uint chosen = (x - (float)i) < e.prob ? i : e.alias;
+  *pmf = scene->light_alias[chosen].pmf;
+  return chosen;
+}
 
 /* KHR_lights_punctual's recommended range window, applied only when a range is given. */
 inline float range_window(float dist, float range) {
@@ -18,15 +44,17 @@ inline float range_window(float dist, float range) {
   return clamp(1.0f - pow(dist / range, 4.0f), 0.0f, 1.0f);
 }
 
-inline LightSample sample_punctual_light(__global const PunctualLight* light, float3 p) {
+inline LightSample sample_punctual(__global const Light* light, float3 p) {
   LightSample s;
-  const float4 pos = light->position;
+  s.delta = true;
+  s.pdf = 1.0f;
   if (light->meta.x == WP_LIGHT_DIRECTIONAL) {
     s.wi = -light->direction.xyz;
     s.dist = INFINITY;
     s.li = light->intensity.xyz;
     return s;
   }
+  const float4 pos = light->position;
   const float3 to_light = pos.xyz - p;
   const float d2 = dot(to_light, to_light);
   s.dist = sqrt(d2);
@@ -40,6 +68,76 @@ inline LightSample sample_punctual_light(__global const PunctualLight* light, fl
   }
 #endif
   return s;
+}
+
+/* Solid-angle density of reaching point q of triangle `tv` (area-uniform sampling) from distance
+ * `dist` along a direction making cos_light with the triangle's normal. */
+inline float triangle_solid_angle_pdf(float area, float dist, float cos_light) {
+  return dist * dist / (area * fabs(cos_light));
+}
+
+inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, float2 u) {
+  LightSample s;
+  s.delta = false;
+  s.pdf = 0.0f;
+  s.li = (float3)(0.0f);
+  const uint4 tv = scene->tri_vertices[tri];
+  const float3 p0 = scene->positions[tv.x].xyz;
+  const float3 e1 = scene->positions[tv.y].xyz - p0;
+  const float3 e2 = scene->positions[tv.z].xyz - p0;
+  /* Uniform over the area: b1 = 1 - sqrt(u1)... written as barycentrics of v1 and v2. */
+  const float r = sqrt(u.x);
+  const float b1 = r * (1.0f - u.y), b2 = r * u.y;
+  const float3 q = p0 + b1 * e1 + b2 * e2;
+  const float3 n = cross(e1, e2);
+  const float area2 = length(n);
+  const float3 to_light = q - p;
+  s.dist = length(to_light);
+  s.wi = to_light / s.dist;
+  const float cos_light = -dot(n, s.wi) / area2; /* > 0: the front faces the shading point */
+  const bool double_sided = scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED;
+  if (!(s.dist > 0.0f) || !(cos_light > 0.0f || (double_sided && cos_light < 0.0f))) return s;
+  s.pdf = triangle_solid_angle_pdf(0.5f * area2, s.dist, cos_light);
+  s.li = material_emission(scene, tv, b1, b2);
+  return s;
+}
+
+/* One light sample for the shading point p. */
+inline LightSample sample_light(const SceneView* scene, float3 p, float u_pick, float2 u) {
+  float pmf;
+  const uint i = pick_light(scene, u_pick, &pmf);
+  __global const Light* light = scene->lights + i;
+  LightSample s;
+  const uint type = light->meta.x;
+  if (type == WP_LIGHT_TRIANGLE) {
+    s = sample_triangle(scene, light->meta.y, p, u);
+  } else if (type == WP_LIGHT_ENVIRONMENT) {
+    s.li = env_sample(scene, u, &s.wi, &s.pdf);
+    s.dist = INFINITY;
+    s.delta = false;
+  } else {
+    s = sample_punctual(light, p);
+  }
+  s.pdf *= pmf;
+  return s;
+}
+
+/* The pdf with which NEE would have produced the direction of a ray that hit emissive triangle
+ * `tri` at distance dist with cos_light between ray and triangle normal. */
+inline float triangle_light_pdf(const SceneView* scene, uint tri, float dist, float cos_light) {
+  const uint li = scene->tri_light[tri];
+  if (li == WP_NO_LIGHT) return 0.0f;
+  const uint4 tv = scene->tri_vertices[tri];
+  const float3 p0 = scene->positions[tv.x].xyz;
+  const float area =
+      0.5f * length(cross(scene->positions[tv.y].xyz - p0, scene->positions[tv.z].xyz - p0));
+  return scene->light_alias[li].pmf * triangle_solid_angle_pdf(area, dist, cos_light);
+}
+
+/* The pdf with which NEE would have produced an escaped ray's direction. */
+inline float environment_light_pdf(const SceneView* scene, float3 dir) {
+  const uint li = scene->desc->env_light;
+  return li == WP_NO_LIGHT ? 0.0f : scene->light_alias[li].pmf * env_pdf(scene, dir);
 }
 
 #endif /* WP_LIGHTS_H */

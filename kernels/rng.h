@@ -20,6 +20,8 @@
 #define WP_DIM_BSDF_U 6u
 #define WP_DIM_BSDF_V 7u
 #define WP_DIM_ROULETTE 8u
+#define WP_DIM_ALPHA_CLOSEST 9u /* stochastic alpha of the closest-hit ray (a key, see alpha.h) */
+#define WP_DIM_ALPHA_SHADOW 10u /* ... and of the shadow ray */
 #define WP_DIMS_PER_BOUNCE 16u
 
 inline uint wp_hash(uint x) {
@@ -40,11 +42,15 @@ inline Rng rng_make(uint pixel, uint sample, uint seed, uint bounce) {
   return r;
 }
 
-inline float rng_get(Rng r, uint dim) {
+/* The 32 random bits of dimension `dim`. */
+inline uint rng_bits(Rng r, uint dim) {
   uint h = wp_hash(r.bounce * WP_DIMS_PER_BOUNCE + dim + wp_hash(r.seed));
   h = wp_hash(h ^ r.sample);
-  h = wp_hash(h ^ r.pixel);
-  return (float)(h >> 8) * (1.0f / 16777216.0f);
+  return wp_hash(h ^ r.pixel);
+}
+
+inline float rng_get(Rng r, uint dim) {
+  return (float)(rng_bits(r, dim) >> 8) * (1.0f / 16777216.0f);
 }
 
 inline float2 rng_get2(Rng r, uint dim) {

@@ -1,27 +1,35 @@
 /* Stage: next-event estimation (light sampling).
  * From: WP_QUEUE_SURFACE.
- * To:   WP_QUEUE_SHADOW with a shadow ray toward one light and the radiance it adds if unoccluded.
- * One punctual light is chosen uniformly (probability 1 / light_count). Punctual lights are delta
- * distributions no BSDF sample can hit, so NEE is their only strategy: MIS weight 1. */
+ * To:   WP_QUEUE_SHADOW with a shadow ray toward one sampled light point and the radiance it adds
+ *       if unoccluded: throughput * f * |cos| * L / pdf * w_light (lights.h, mis.h).
+ * Skipped entirely with WP_STRATEGY_BSDF, and on surfaces with nothing but delta lobes. */
 #include "stage.h"
 #include "lights.h"
+#include "mis.h"
 #include "surface.h"
 
 __kernel void sample_lights(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
   uint slot;
   if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
-#if WP_FEATURE_PUNCTUAL_LIGHTS
-  const uint count = scene.light_count;
-  if (count == 0) return;
+#if WP_STRATEGY != WP_STRATEGY_BSDF
+  if (scene_desc.light_count == 0) return;
   const Surface s = surface_load(paths, slot);
+  if (bsdf_only_delta(&s)) return;
   const Rng rng = path_rng(paths, slot, launch);
-  const uint pick = min((uint)(rng_get(rng, WP_DIM_LIGHT_PICK) * (float)count), count - 1u);
-  const LightSample ls = sample_punctual_light(scene.lights + pick, s.p);
+  const LightSample ls =
+      sample_light(&scene, s.p, rng_get(rng, WP_DIM_LIGHT_PICK), rng_get2(rng, WP_DIM_LIGHT_U));
+  if (!(ls.pdf > 0.0f)) return;
   const BsdfEval e = bsdf_eval(&s, -paths.ray_d[slot].xyz, ls.wi);
-  const float3 c = paths.throughput[slot].xyz * e.f * (dot(s.ns, ls.wi) * (float)count) * ls.li;
+  const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
+  const float3 c = paths.throughput[slot].xyz * e.f * ls.li * (fabs(dot(s.ns, ls.wi)) * w / ls.pdf);
   if (!(max3(c) > 0.0f)) return;
-  paths.shadow_o[slot] = (float4)(offset_origin(s.p, s.ng), ls.dist);
+  /* The shadow ray leaves the side of the surface the light is on (transmission can light the
+   * back) and stops short of an area light's surface by the same robust offset. */
+  const float3 o = offset_origin(s.p, dot(s.ng, ls.wi) > 0.0f ? s.ng : -s.ng);
+  float tmax = ls.dist;
+  if (ls.dist < INFINITY) tmax = length(s.p + ls.wi * ls.dist - o) * (1.0f - 1e-5f);
+  paths.shadow_o[slot] = (float4)(o, tmax);
   paths.shadow_d[slot] = (float4)(ls.wi, 0.0f);
   paths.shadow_l[slot] = (float4)(c, 0.0f);
   queue_push(queues, WP_QUEUE_SHADOW, slot);

@@ -4,7 +4,6 @@
 
 #include "bsdf.h"
 #include "path_state.h"
-#include "rng.h"
 
 inline void surface_store(Paths paths, uint slot, const Surface* s) {
   paths.surf_p[slot] = (float4)(s->p, 0.0f);
@@ -25,12 +24,6 @@ inline Surface surface_load(Paths paths, uint slot) {
   s.metallic = c.w;
   s.roughness = q.x, s.ior = q.y, s.transmission = q.z;
   return s;
-}
-
-/* The random numbers of the path in `slot` at its current bounce. */
-inline Rng path_rng(Paths paths, uint slot, Launch launch) {
-  const uint4 info = paths.info[slot];
-  return rng_make(info.x, launch.sample, launch.seed, info.y);
 }
 
 #endif /* WP_SURFACE_H */

@@ -9,8 +9,8 @@ __kernel void trace_shadow(WP_STAGE_PARAMS) {
   uint slot;
   if (!queue_get(queues, WP_QUEUE_SHADOW, get_global_id(0), &slot)) return;
   const float4 o = paths.shadow_o[slot];
-  const TraceRay ray = trace_ray(o.xyz, paths.shadow_d[slot].xyz, 0.0f);
+  const uint key = rng_bits(path_rng(paths, slot, launch), WP_DIM_ALPHA_SHADOW);
+  const TraceRay ray = trace_ray(o.xyz, paths.shadow_d[slot].xyz, 0.0f, key);
   TraceHit hit;
-  if (!bvh_trace(scene.nodes, scene.tris, &ray, o.w, &hit, true))
-    paths.radiance[slot] += paths.shadow_l[slot];
+  if (!bvh_trace(&scene, &ray, o.w, &hit, true)) paths.radiance[slot] += paths.shadow_l[slot];
 }

@@ -9,6 +9,7 @@
 #define WP_TRAVERSE_H
 
 #include "common.h"
+#include "alpha.h"
 
 /* No fused multiply-adds here: the CPU reference is written without them, and with contraction
  * the kernel's results differ from it in the last bits (and, measured on PoCL, some rays missed a
@@ -20,6 +21,7 @@ typedef struct TraceRay {
   float dx, dy, dz;
   float ix, iy, iz; /* clamped reciprocal direction */
   float tmin;
+  uint alpha_key; /* identifies the ray's path and bounce for stochastic alpha (alpha.h) */
 } TraceRay;
 
 typedef struct TraceHit {
@@ -31,12 +33,13 @@ inline float safe_rcp(float d) {
   return 1.0f / (fabs(d) > 1e-20f ? d : copysign(1e-20f, d));
 }
 
-inline TraceRay trace_ray(float3 o, float3 d, float tmin) {
+inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key) {
   TraceRay r;
   r.ox = o.x, r.oy = o.y, r.oz = o.z;
   r.dx = d.x, r.dy = d.y, r.dz = d.z;
   r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
   r.tmin = tmin;
+  r.alpha_key = alpha_key;
   return r;
 }
 
@@ -53,7 +56,8 @@ inline float box_entry(const TraceRay* r, float lox, float hix, float loy, float
 }
 
 /* Moller-Trumbore against one stored triangle. On a hit closer than hit->t, updates *hit. */
-inline bool triangle_test(const TraceRay* r, __global const IsectTri* tri, TraceHit* hit) {
+inline bool triangle_test(const SceneView* scene, const TraceRay* r, __global const IsectTri* tri,
+                          TraceHit* hit) {
   const float4 v0 = tri->v0, e1 = tri->e1, e2 = tri->e2;
   const float px = r->dy * e2.z - r->dz * e2.y;
   const float py = r->dz * e2.x - r->dx * e2.z;
@@ -72,17 +76,23 @@ inline bool triangle_test(const TraceRay* r, __global const IsectTri* tri, Trace
   if (v < 0.0f || u + v > 1.0f) return false;
   const float t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv;
   if (!(t > r->tmin && t < hit->t)) return false;
+#if WP_FEATURE_ALPHA
+  if ((as_uint(e1.w) & WP_TRI_ALPHA) && !alpha_passes(scene, as_uint(v0.w), u, v, r->alpha_key))
+    return false;
+#else
+  (void)scene;
+#endif
   hit->t = t, hit->u = u, hit->v = v, hit->tri = as_uint(v0.w);
   return true;
 }
 
 /* Intersects the leaf [first, first + count); with `any`, stops at the first hit. */
-inline bool leaf_test(const TraceRay* r, __global const IsectTri* tris, int ref, int count,
-                      TraceHit* hit, bool any) {
+inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref, int count, TraceHit* hit,
+                      bool any) {
   bool found = false;
-  __global const IsectTri* tri = tris + ~ref;
+  __global const IsectTri* tri = scene->tris + ~ref;
   for (int i = 0; i < count; ++i) {
-    if (triangle_test(r, tri + i, hit)) {
+    if (triangle_test(scene, r, tri + i, hit)) {
       found = true;
       if (any) return true;
     }
@@ -92,8 +102,9 @@ inline bool leaf_test(const TraceRay* r, __global const IsectTri* tris, int ref,
 
 /* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
  * hit; the hit record holds the closest one found. */
-inline bool bvh_trace(__global const BvhNode* nodes, __global const IsectTri* tris,
-                      const TraceRay* r, float tmax, TraceHit* hit, bool any) {
+inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
+                      bool any) {
+  __global const BvhNode* nodes = scene->nodes;
   int stack[WP_BVH_STACK_SIZE];
   int sp = 0;
   int node = 0;
@@ -106,12 +117,12 @@ inline bool bvh_trace(__global const BvhNode* nodes, __global const IsectTri* tr
     float t0 = box_entry(r, a.x, a.y, a.z, a.w, z.x, z.y, hit->t);
     float t1 = box_entry(r, b.x, b.y, b.z, b.w, z.z, z.w, hit->t);
     if (t0 < INFINITY && link.x < 0) {
-      found |= leaf_test(r, tris, link.x, link.z, hit, any);
+      found |= leaf_test(scene, r, link.x, link.z, hit, any);
       if (found && any) return true;
       t0 = INFINITY;
     }
     if (t1 < INFINITY && link.y < 0) {
-      found |= leaf_test(r, tris, link.y, link.w, hit, any);
+      found |= leaf_test(scene, r, link.y, link.w, hit, any);
       if (found && any) return true;
       t1 = INFINITY;
     }

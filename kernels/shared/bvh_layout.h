@@ -29,6 +29,7 @@
 
 /* Triangle flags (IsectTri.e1.w). */
 #define WP_TRI_CULL_BACKFACE 1u /* single-sided material: back faces are not there for any ray */
+#define WP_TRI_ALPHA 2u         /* alphaMode MASK or BLEND: a hit counts only if alpha_passes() */
 
 WP_DEV_BEGIN
 

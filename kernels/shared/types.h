@@ -13,11 +13,26 @@
 
 /* Material flags (Material.flags.x). */
 #define WP_MAT_DOUBLE_SIDED 1u
+#define WP_MAT_ALPHA_MASK 2u  /* alphaMode MASK: a cutout at alpha_cutoff */
+#define WP_MAT_ALPHA_BLEND 4u /* alphaMode BLEND: present with probability alpha */
+#define WP_MAT_UNLIT 8u       /* KHR_materials_unlit: shows its base colour, scatters nothing */
+#define WP_MAT_VOLUME 16u /* KHR_materials_volume (thickness > 0): refraction, absorption inside \
+                           */
 
-/* Punctual light types (PunctualLight.meta.x). */
+/* Texture wrap modes (TextureRef.meta.y, 8 bits each for S and T). */
+#define WP_WRAP_REPEAT 0u
+#define WP_WRAP_CLAMP 1u
+#define WP_WRAP_MIRROR 2u
+#define WP_TEX_NEAREST (1u << 16) /* magnification filter NEAREST (else bilinear) */
+#define WP_TEX_SRGB (1u << 17)    /* texels are sRGB-encoded colour: decode to linear */
+
+/* Light types (Light.meta.x). */
 #define WP_LIGHT_POINT 0u
 #define WP_LIGHT_SPOT 1u
 #define WP_LIGHT_DIRECTIONAL 2u
+#define WP_LIGHT_TRIANGLE 3u    /* an emissive triangle (area light) */
+#define WP_LIGHT_ENVIRONMENT 4u /* the environment map or the constant background */
+#define WP_NO_LIGHT 0xffffffffu
 
 /* Camera types (Camera.meta.x). */
 #define WP_CAMERA_PERSPECTIVE 0u
@@ -39,19 +54,50 @@
 WP_DEV_BEGIN
 
 typedef struct Material {
-  float4 base_color; /* linear RGB; a: alpha */
-  float4 emission;   /* radiance (rgb); w: unused */
-  float4 params;     /* x: metallic, y: roughness, z: ior, w: transmission */
-  uint4 flags;       /* x: WP_MAT_* flags; y, z, w: reserved (texture references) */
+  float4 base_color; /* linear RGB factor; a: alpha factor */
+  float4 emission; /* radiance factor (rgb): emissiveFactor x emissive strength; w: alpha cutoff */
+  float4 params;   /* x: metallic, y: roughness, z: ior, w: transmission */
+  float4 volume;   /* rgb: attenuation colour; w: attenuation distance (INFINITY: no absorption) */
+  float4 extra;    /* x: normal texture scale, y: thickness factor; z, w: unused */
+  uint4 flags;     /* x: WP_MAT_* flags; y, z, w: unused */
+  int4 textures0;  /* TextureRef indices (-1: none): x base colour, y metallic-roughness,
+                      z normal, w emissive */
+  int4 textures1;  /* x: transmission; y, z, w: -1 (reserved) */
 } Material;
 
-typedef struct PunctualLight {
-  float4 position;  /* xyz: world position (point, spot); w: range (0: infinite) */
-  float4 direction; /* xyz: unit direction the light travels (spot, directional); w: unused */
-  float4 intensity; /* rgb: W/sr (point, spot) or W/m^2 (directional); w: unused */
-  float4 spot;      /* x: angle scale, y: angle offset (KHR_lights_punctual recommended falloff) */
-  uint4 meta;       /* x: WP_LIGHT_* type */
-} PunctualLight;
+/* A material's use of a texture: glTF textureInfo + sampler + KHR_texture_transform. */
+typedef struct TextureRef {
+  float4 transform_u; /* u' = x u + y v + z */
+  float4 transform_v; /* v' = x u + y v + z */
+  uint4 meta; /* x: TextureImage index; y: wrap S (bits 0-7) | wrap T (bits 8-15) | WP_TEX_* flags;
+                 z: texture coordinate set (0 or 1); w: unused */
+} TextureRef;
+
+/* A decoded image: width x height texels, row by row from the top (glTF's uv (0,0) is the
+ * top-left corner), each a uint of RGBA8 with R in the lowest byte, starting at `offset` in the
+ * texel array. */
+typedef struct TextureImage {
+  uint offset, width, height, pad;
+} TextureImage;
+
+/* Everything next-event estimation can choose. */
+typedef struct Light {
+  float4 position;  /* point, spot: xyz world position, w: range (0: infinite) */
+  float4 direction; /* spot, directional: unit direction the light travels */
+  float4 intensity; /* point, spot: W/sr; directional: W/m^2 (rgb). Triangles and the environment
+                       take their radiance from the material and the map. */
+  float4 spot;      /* spot: x angle scale, y angle offset (KHR_lights_punctual falloff) */
+  uint4 meta;       /* x: WP_LIGHT_* type; y: scene triangle index (WP_LIGHT_TRIANGLE) */
+} Light;
+
+/* One entry of the alias table that picks a light: keep `index` with probability `prob`, else
+ * take `alias`; `pmf` is the probability that light `index` is picked in all. */
+typedef struct LightAlias {
+  float prob;
+  uint alias;
+  float pmf;
+  uint pad;
+} LightAlias;
 
 typedef struct Camera {
   float4 position; /* xyz: eye; w: znear (distance along forward) */
@@ -64,19 +110,31 @@ typedef struct Camera {
 /* Where each scene array starts in the scene buffer (bytes, 64-aligned), and how many it holds. */
 typedef struct SceneDesc {
   Camera camera;
-  float4 background; /* constant radiance of escaped rays (rgb) */
+  float4 background; /* constant radiance of escaped rays (rgb) when there is no map */
+  float4 env_params; /* x: intensity scale, y: cos, z: sin of the rotation about +Y; w: unused */
   uint bvh_nodes;    /* BvhNode[] */
   uint isect_tris;   /* IsectTri[] */
   uint tri_vertices; /* uint4[]: x, y, z vertex indices, w material index, per scene triangle */
   uint positions;    /* float4[] per vertex: xyz */
   uint normals;      /* float4[] per vertex: xyz unit */
-  uint uvs;          /* float4[] per vertex: xy TEXCOORD_0 */
+  uint tangents;     /* float4[] per vertex: xyz unit tangent, w handedness (+-1) */
+  uint uvs;          /* float4[] per vertex: xy TEXCOORD_0, zw TEXCOORD_1 */
   uint colors;       /* float4[] per vertex: COLOR_0 (linear rgba) */
   uint materials;    /* Material[] */
-  uint lights;       /* PunctualLight[] */
+  uint textures;     /* TextureRef[] */
+  uint images;       /* TextureImage[] */
+  uint texels;       /* uint[] RGBA8 */
+  uint lights;       /* Light[] */
+  uint light_alias;  /* LightAlias[light_count] */
+  uint tri_light;    /* uint[] per scene triangle: its index in lights[], or WP_NO_LIGHT */
+  uint env_texels;   /* float4[] env_width x env_height, linear RGB radiance, rows from +Y down */
+  uint env_marginal; /* environment sampling tables (kernels/environment.h) */
+  uint env_conditional;
+  uint env_width, env_height;
   uint light_count;
+  uint env_light; /* index of the WP_LIGHT_ENVIRONMENT light, or WP_NO_LIGHT */
   uint triangle_count;
-  uint pad0;
+  uint pad0, pad1, pad2;
 } SceneDesc;
 
 /* Byte offset of every path-state field in the path buffer, and the number of path slots. */

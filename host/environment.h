@@ -1,0 +1,35 @@
+// Environment lighting: an equirectangular radiance map (.hdr via stb_image, .exr via OpenEXR)
+// and the tables that importance-sample it (kernels/environment.h reads them).
+//
+// Direction convention (+Y up, glTF's frame): the map's u runs with the azimuth
+// phi = atan2(d.x, -d.z), u = (phi + pi) / (2 pi), so the centre column (u = 0.5) is seen looking
+// down -Z (a glTF camera at rest); v = acos(d.y) / pi, row 0 at the top (+Y). A rotation of R
+// degrees turns the map about +Y by R (counter-clockwise seen from above).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+namespace wp {
+
+struct EnvironmentMap {
+  std::string source;
+  int width = 0, height = 0;
+  std::vector<glm::vec4> texels;  // linear RGB radiance, row by row from the top; w unused
+  // Sampling tables in the layout kernels/environment.h expects (see there).
+  std::vector<float> marginal;     // per row
+  std::vector<float> conditional;  // per texel
+  // Mean radiance luminance over the sphere (solid-angle weighted), for light selection by power.
+  double mean_luminance = 0.0;
+};
+
+// Loads an equirectangular map. Throws wp::Error naming the file when it is missing, unreadable,
+// of an unsupported format, or holds non-finite or negative values.
+EnvironmentMap load_environment(const std::string& path);
+
+// Builds the sampling tables and mean_luminance from texels/width/height.
+void build_environment_tables(EnvironmentMap& env);
+
+}  // namespace wp

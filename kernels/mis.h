@@ -1,0 +1,55 @@
+/* Multiple importance sampling of direct light (the second level; the first is the choice of a
+ * light, lights.h). Two strategies can produce the same light path: NEE (a light sample, pdf
+ * p_light in solid angle, the light-choice probability included) and BSDF sampling (pdf p_bsdf).
+ * Each contribution is weighted by w = h(p_own, p_other), with h the balance heuristic
+ * p / (p + q) or the power heuristic p^2 / (p^2 + q^2). A delta light or a delta lobe can only be
+ * found by one strategy: its weight is 1 (callers pass q = 0).
+ *
+ * WP_STRATEGY selects what is counted: MIS (both, weighted), NEE (light samples with weight 1;
+ * emission found by BSDF sampling only where NEE cannot reach it: after a delta lobe or from the
+ * camera) or BSDF (no NEE; all emission found by BSDF sampling, weight 1; punctual lights then
+ * contribute nothing, which is the expected answer for that strategy). */
+#ifndef WP_MIS_H
+#define WP_MIS_H
+
+#include "common.h"
+
+inline float mis_weight(float p_own, float p_other) {
+  if (!(p_other > 0.0f)) return 1.0f;
+#if WP_MIS_POWER
+  const float a = p_own * p_own, b = p_other * p_other;
+#else
+  const float a = p_own, b = p_other;
+#endif
+  return a / (a + b);
+}
+
+/* Weight of emission that a BSDF-sampled ray found, given the pdf of that sample (0 after a
+ * delta lobe or for a camera ray) and the pdf with which NEE would have produced it. */
+inline float mis_weight_bsdf_hit(float p_bsdf, float p_light) {
+#if WP_STRATEGY == WP_STRATEGY_MIS
+  return p_bsdf > 0.0f ? mis_weight(p_bsdf, p_light) : 1.0f;
+#elif WP_STRATEGY == WP_STRATEGY_NEE
+  (void)p_light;
+  return p_bsdf > 0.0f ? 0.0f : 1.0f;
+#else
+  (void)p_bsdf;
+  (void)p_light;
+  return 1.0f;
+#endif
+}
+
+/* Weight of a light sample with pdf p_light (0 < p_light; `delta` for a delta light) against the
+ * BSDF's pdf p_bsdf of the same direction. */
+inline float mis_weight_light(float p_light, float p_bsdf, bool delta) {
+#if WP_STRATEGY == WP_STRATEGY_MIS
+  return delta ? 1.0f : mis_weight(p_light, p_bsdf);
+#else
+  (void)p_light;
+  (void)p_bsdf;
+  (void)delta;
+  return 1.0f;
+#endif
+}
+
+#endif /* WP_MIS_H */
