@@ -24,12 +24,18 @@
 
 #define WP_DELTA_ROUGHNESS 0.01f
 
+/* Surface flags. */
+#define WP_SURF_UNLIT 1u  /* KHR_materials_unlit: shows `color`, scatters nothing */
+#define WP_SURF_VOLUME 2u /* transmission bends rays (KHR_materials_volume); else thin-walled */
+#define WP_SURF_FRONT 4u  /* the ray arrived on the front (counter-clockwise) side */
+
 typedef struct Surface {
   float3 p;  /* position */
   float3 ng; /* geometric normal, on the side of wo */
   float3 ns; /* shading normal, same side */
   float3 color;
   float metallic, roughness, ior, transmission;
+  uint flags; /* WP_SURF_* */
 } Surface;
 
 typedef struct BsdfEval {

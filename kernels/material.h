@@ -50,6 +50,13 @@ inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u, float 
   s.roughness = q.y;
   s.ior = q.z;
   s.transmission = q.w;
+  s.flags = *front ? WP_SURF_FRONT : 0u;
+#if WP_FEATURE_UNLIT
+  if (m->flags.x & WP_MAT_UNLIT) s.flags |= WP_SURF_UNLIT;
+#endif
+#if WP_FEATURE_VOLUME
+  if (m->flags.x & WP_MAT_VOLUME) s.flags |= WP_SURF_VOLUME;
+#endif
   return s;
 }
 

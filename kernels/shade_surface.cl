@@ -35,6 +35,12 @@ __kernel void shade_surface(WP_STAGE_PARAMS) {
     }
   }
 #endif
+#if WP_FEATURE_UNLIT
+  if (s.flags & WP_SURF_UNLIT) { /* shows its colour as emitted radiance; nothing scatters */
+    paths.radiance[slot].xyz += beta.xyz * s.color;
+    return;
+  }
+#endif
   if (paths.info[slot].y >= launch.max_depth) return;
   surface_store(paths, slot, &s);
   queue_push(queues, WP_QUEUE_SURFACE, slot);

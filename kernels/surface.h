@@ -10,7 +10,7 @@ inline void surface_store(Paths paths, uint slot, const Surface* s) {
   paths.surf_ng[slot] = (float4)(s->ng, 0.0f);
   paths.surf_ns[slot] = (float4)(s->ns, 0.0f);
   paths.surf_color[slot] = (float4)(s->color, s->metallic);
-  paths.surf_params[slot] = (float4)(s->roughness, s->ior, s->transmission, 0.0f);
+  paths.surf_params[slot] = (float4)(s->roughness, s->ior, s->transmission, as_float(s->flags));
 }
 
 inline Surface surface_load(Paths paths, uint slot) {
@@ -23,6 +23,7 @@ inline Surface surface_load(Paths paths, uint slot) {
   s.color = c.xyz;
   s.metallic = c.w;
   s.roughness = q.x, s.ior = q.y, s.transmission = q.z;
+  s.flags = as_uint(q.w);
   return s;
 }
 
