@@ -22,13 +22,17 @@
 #include "host/gltf_material.h"
 #include "host/gltf_nodes.h"
 #include "host/gltf_primitive.h"
+#include "host/gltf_textures.h"
 
 namespace wp {
 namespace {
 
 const std::set<std::string> kSupportedExtensions = {
-    "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
-    "KHR_materials_transmission", "KHR_mesh_quantization"};
+    "KHR_lights_punctual",    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",      "KHR_materials_transmission",
+    "KHR_materials_unlit",    "KHR_materials_volume",
+    "KHR_materials_specular", "KHR_mesh_quantization",
+    "KHR_texture_transform"};
 
 // tinygltf's messages span lines; wavepath's errors are one line.
 std::vector<std::string> lines(const std::string& text) {
@@ -50,12 +54,6 @@ std::string one_line(const std::string& text) {
   std::string out;
   for (const std::string& line : lines(text)) out += (out.empty() ? "" : "; ") + line;
   return out.empty() ? "tinygltf gave no reason" : out;
-}
-
-// Textures come later: keep image bytes undecoded so that loads stay fast.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
-  return true;
 }
 
 std::vector<unsigned char> read_file(const std::string& path) {
@@ -116,7 +114,7 @@ tinygltf::Model parse(const std::string& path, std::vector<std::string>* warning
     throw Error(path + ": not a binary glTF file (no 'glTF' magic)");
 
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetImageLoader(&gltf::keep_encoded_image, nullptr);  // decoded when used (gltf_textures)
   tinygltf::Model model;
   std::string err, warn;
   const std::string base = std::filesystem::path(path).parent_path().string();
@@ -154,8 +152,6 @@ void check_extensions(const tinygltf::Model& model, const std::string& path,
   for (const std::string& name : model.extensionsUsed)
     if (!kSupportedExtensions.count(name))
       warnings->push_back(path + ": ignoring unsupported extension " + name);
-  if (!model.textures.empty())
-    warnings->push_back(path + ": textures are not supported yet; using material factors");
 }
 
 // Fills the scene from the node tree of one glTF scene. Messages lack the file name; load_gltf
@@ -170,12 +166,14 @@ class SceneBuilder {
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
   std::uint32_t material_index(int material);
+  gltf::VertexNeeds vertex_needs(std::uint32_t material) const;
   void warn_once(int mesh, std::size_t primitive, const std::string& message);
   static std::string revisit_message(const std::vector<int>& parent, int node, int from);
 
   const tinygltf::Model& model_;
   Scene& scene_;
   std::optional<std::uint32_t> default_material_;
+  gltf::VertexNeeds file_needs_;  // uv1 and tangents: whether the scene keeps them at all
   std::set<std::pair<int, std::size_t>> warned_;  // (mesh, primitive): instances warn once
 };
 
@@ -183,6 +181,8 @@ class SceneBuilder {
 // a deep hierarchy must not overflow the call stack.
 void SceneBuilder::build(int scene_index) {
   const tinygltf::Scene& scene = model_.scenes[static_cast<std::size_t>(scene_index)];
+  for (const TextureRef& t : scene_.textures) file_needs_.uv1 |= t.texcoord == 1;
+  for (const Material& m : scene_.materials) file_needs_.tangents |= m.normal_texture >= 0;
   constexpr int kUnvisited = -2, kRoot = -1;
   std::vector<int> parent(model_.nodes.size(), kUnvisited);
   struct Item {
@@ -246,8 +246,9 @@ void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
       continue;
     }
     try {
+      const std::uint32_t material = material_index(p.material);
       const std::size_t leftover =
-          gltf::append_primitive(model_, p, world, material_index(p.material), scene_);
+          gltf::append_primitive(model_, p, world, material, vertex_needs(material), scene_);
       if (leftover != 0)
         warn_once(
             mesh_index, i,
@@ -271,6 +272,15 @@ std::uint32_t SceneBuilder::material_index(int material) {
     scene_.materials.push_back(gltf::default_material());
   }
   return *default_material_;
+}
+
+// TEXCOORD_1 and tangents are kept for every vertex when any texture reads set 1 or any material
+// has a normal texture, and for none otherwise (scene.h).
+gltf::VertexNeeds SceneBuilder::vertex_needs(std::uint32_t material) const {
+  gltf::VertexNeeds needs = file_needs_;
+  const int normal = scene_.materials[material].normal_texture;
+  if (normal >= 0) needs.tangent_uv = scene_.textures[static_cast<std::size_t>(normal)].texcoord;
+  return needs;
 }
 
 void SceneBuilder::warn_once(int mesh, std::size_t primitive, const std::string& message) {
@@ -302,8 +312,9 @@ Scene load_gltf(const std::string& path) {
     const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (static_cast<std::size_t>(scene_index) >= model.scenes.size())
       throw Error("default scene " + std::to_string(scene_index) + " does not exist");
+    gltf::TextureTable textures(model, scene);
     for (std::size_t i = 0; i < model.materials.size(); ++i)
-      scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i)));
+      scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i), textures));
     SceneBuilder(model, scene).build(scene_index);
     if (scene.triangle_count() == 0)
       throw Error("no triangles in scene " + std::to_string(scene_index));

@@ -14,14 +14,23 @@ float finite(double value, const std::string& where, const char* field) {
   return static_cast<float>(value);
 }
 
+// The object of material extension `name`, or null when the material does not use it.
+const tinygltf::Value* extension(const tinygltf::Material& m, const char* name,
+                                 const std::string& where) {
+  const auto it = m.extensions.find(name);
+  if (it == m.extensions.end()) return nullptr;
+  if (!it->second.IsObject()) throw Error(where + ": " + name + " is not an object");
+  return &it->second;
+}
+
 // A number from a material extension's object, or `fallback` when the extension or the field is
 // absent.
-float extension_number(const tinygltf::Material& m, const char* extension, const char* field,
+float extension_number(const tinygltf::Material& m, const char* name, const char* field,
                        float fallback, const std::string& where) {
-  const auto it = m.extensions.find(extension);
-  if (it == m.extensions.end() || !it->second.IsObject() || !it->second.Has(field)) return fallback;
-  const tinygltf::Value& v = it->second.Get(field);
-  if (!v.IsNumber()) throw Error(where + ": " + extension + "." + field + " is not a number");
+  const tinygltf::Value* ext = extension(m, name, where);
+  if (!ext || !ext->Has(field)) return fallback;
+  const tinygltf::Value& v = ext->Get(field);
+  if (!v.IsNumber()) throw Error(where + ": " + name + "." + field + " is not a number");
   return finite(v.GetNumberAsDouble(), where, field);
 }
 
@@ -32,23 +41,29 @@ AlphaMode alpha_mode(const std::string& mode, const std::string& where) {
   throw Error(where + ": unknown alphaMode '" + mode + "'");
 }
 
-}  // namespace
-
-Material default_material() {
-  Material m;
-  m.name = "default";
-  return m;  // Material's member defaults are glTF's
+// KHR_materials_volume: thickness, attenuation colour and distance (absent: infinite, stored 0).
+void read_volume(const tinygltf::Material& in, const std::string& where, Material& out) {
+  const char* kName = "KHR_materials_volume";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  if (!ext) return;
+  out.thickness = extension_number(in, kName, "thicknessFactor", 0.0f, where);
+  if (out.thickness < 0.0f) throw Error(where + ": negative thicknessFactor");
+  out.attenuation_distance = extension_number(in, kName, "attenuationDistance", 0.0f, where);
+  if (ext->Has("attenuationDistance") && !(out.attenuation_distance > 0.0f))
+    throw Error(where + ": attenuationDistance must be positive");
+  if (ext->Has("attenuationColor")) {
+    const tinygltf::Value& c = ext->Get("attenuationColor");
+    if (!c.IsArray() || c.ArrayLen() != 3)
+      throw Error(where + ": attenuationColor needs 3 numbers");
+    for (int i = 0; i < 3; ++i) {
+      if (!c.Get(i).IsNumber()) throw Error(where + ": attenuationColor is not numbers");
+      out.attenuation_color[i] = finite(c.Get(i).GetNumberAsDouble(), where, "attenuationColor");
+    }
+  }
 }
 
-Material convert_material(const tinygltf::Model& model, int index) {
-  if (index < 0 || static_cast<std::size_t>(index) >= model.materials.size())
-    throw Error("material " + std::to_string(index) + " does not exist");
-  const tinygltf::Material& in = model.materials[static_cast<std::size_t>(index)];
-  const std::string where = "material " + std::to_string(index) + " '" + in.name + "'";
+void read_factors(const tinygltf::Material& in, const std::string& where, Material& out) {
   const tinygltf::PbrMetallicRoughness& pbr = in.pbrMetallicRoughness;
-
-  Material out;
-  out.name = in.name;
   if (pbr.baseColorFactor.size() != 4)
     throw Error(where + ": baseColorFactor needs 4 numbers, has " +
                 std::to_string(pbr.baseColorFactor.size()));
@@ -76,6 +91,52 @@ Material convert_material(const tinygltf::Model& model, int index) {
   out.transmission = std::clamp(
       extension_number(in, "KHR_materials_transmission", "transmissionFactor", 0.0f, where), 0.0f,
       1.0f);
+  out.unlit = in.extensions.count("KHR_materials_unlit") != 0;
+  read_volume(in, where, out);
+  // KHR_materials_specular: the factor scales the dielectric Fresnel term (kernels/bsdf.h);
+  // specularColorFactor and the two textures are not applied yet.
+  out.specular = std::clamp(
+      extension_number(in, "KHR_materials_specular", "specularFactor", 1.0f, where), 0.0f, 1.0f);
+}
+
+// Colour textures (base colour, emissive) are sRGB-encoded; the others hold linear data.
+void read_textures(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
+                   Material& out) {
+  const tinygltf::PbrMetallicRoughness& pbr = in.pbrMetallicRoughness;
+  out.base_color_texture =
+      textures.add(texture_info(pbr.baseColorTexture), true, where + ": baseColorTexture");
+  out.metallic_roughness_texture = textures.add(texture_info(pbr.metallicRoughnessTexture), false,
+                                                where + ": metallicRoughnessTexture");
+  out.normal_texture =
+      textures.add(texture_info(in.normalTexture), false, where + ": normalTexture");
+  out.normal_scale = finite(in.normalTexture.scale, where, "normalTexture.scale");
+  out.emissive_texture =
+      textures.add(texture_info(in.emissiveTexture), true, where + ": emissiveTexture");
+  const tinygltf::Value* transmission = extension(in, "KHR_materials_transmission", where);
+  if (transmission && transmission->Has("transmissionTexture")) {
+    const std::string at = where + ": transmissionTexture";
+    out.transmission_texture =
+        textures.add(texture_info(transmission->Get("transmissionTexture"), at), false, at);
+  }
+}
+
+}  // namespace
+
+Material default_material() {
+  Material m;
+  m.name = "default";
+  return m;  // Material's member defaults are glTF's
+}
+
+Material convert_material(const tinygltf::Model& model, int index, TextureTable& textures) {
+  if (index < 0 || static_cast<std::size_t>(index) >= model.materials.size())
+    throw Error("material " + std::to_string(index) + " does not exist");
+  const tinygltf::Material& in = model.materials[static_cast<std::size_t>(index)];
+  const std::string where = "material " + std::to_string(index) + " '" + in.name + "'";
+  Material out;
+  out.name = in.name;
+  read_factors(in, where, out);
+  read_textures(in, where, textures, out);
   return out;
 }
 

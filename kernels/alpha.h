@@ -1,20 +1,45 @@
 /* Alpha for ray traversal: whether a hit on a triangle whose material has alphaMode MASK or BLEND
- * (IsectTri flag WP_TRI_ALPHA) counts. MASK: a cutout where alpha < alphaCutoff. BLEND: stochastic
- * transparency, the surface is there with probability alpha, decided by a hash of the ray's
- * `key` (path, sample, bounce) and the triangle, so closest-hit and shadow rays of one path agree
- * and the image stays independent of queue order. */
+ * (IsectTri flag WP_TRI_ALPHA) counts. Alpha = base colour factor alpha x base colour texture
+ * alpha x vertex colour alpha. MASK: a cutout, the surface is there where alpha >= alphaCutoff.
+ * BLEND: stochastic transparency, the surface is there with probability alpha, decided by a hash
+ * of the ray's `key` (path, sample, bounce, ray kind) and the triangle; it is stateless, so the
+ * image stays independent of queue order, and the decisions for different triangles along one
+ * ray are independent. Averaged over samples this is exactly "over" compositing of the layers. */
 #ifndef WP_ALPHA_H
 #define WP_ALPHA_H
 
+#include "rng.h"
 #include "scene.h"
+#include "textures.h" /* unconditionally: the source expander includes each header once */
+
+/* The material alpha of triangle `tri` at barycentrics (u, v) of its vertices 1 and 2. */
+inline float material_alpha(const SceneView* scene, uint tri, float u, float v) {
+  const uint4 tv = scene->tri_vertices[tri];
+  __global const Material* m = scene->materials + tv.w;
+  const float w = 1.0f - u - v;
+  float alpha = m->base_color.w *
+                (w * scene->colors[tv.x].w + u * scene->colors[tv.y].w + v * scene->colors[tv.z].w);
+#if WP_FEATURE_TEXTURES
+  if (m->textures0.x >= 0) {
+    const float4 uv = w * scene->uvs[tv.x] + u * scene->uvs[tv.y] + v * scene->uvs[tv.z];
+    alpha *= texture_sample(scene, m->textures0.x, uv).w;
+  }
+#endif
+  return alpha;
+}
+
+/* A uniform number in [0, 1) (a multiple of 2^-24) from the ray's key and the triangle. */
+inline float alpha_random(uint key, uint tri) {
+  return (float)(wp_hash(key ^ wp_hash(tri ^ 0x9e3779b9u)) >> 8) * (1.0f / 16777216.0f);
+}
 
 inline bool alpha_passes(const SceneView* scene, uint tri, float u, float v, uint key) {
-  (void)scene;
-  (void)tri;
-  (void)u;
-  (void)v;
-  (void)key;
-  return true;
+  __global const Material* m = scene->materials + scene->tri_vertices[tri].w;
+  const uint flags = m->flags.x;
+  if (!(flags & (WP_MAT_ALPHA_MASK | WP_MAT_ALPHA_BLEND))) return true;
+  const float alpha = material_alpha(scene, tri, u, v);
+  if (flags & WP_MAT_ALPHA_MASK) return alpha >= m->emission.w;
+  return alpha_random(key, tri) < alpha;
 }
 
 #endif /* WP_ALPHA_H */

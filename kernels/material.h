@@ -2,22 +2,108 @@
  *
  * resolve_surface() interpolates the triangle's attributes at barycentrics (u, v) and evaluates
  * the material there. Textures (base colour, metallic-roughness, normal, emissive, transmission),
- * KHR_texture_transform, alpha and KHR_materials_unlit are resolved here and nowhere else. */
+ * KHR_texture_transform and KHR_materials_unlit are resolved here and nowhere else (alpha, which
+ * decides whether a hit counts at all, in alpha.h). Each texture multiplies its factor, as glTF
+ * specifies; everything texture-related compiles only with WP_FEATURE_TEXTURES (normal maps:
+ * WP_FEATURE_NORMAL_MAPS). */
 #ifndef WP_MATERIAL_H
 #define WP_MATERIAL_H
 
 #include "bsdf.h"
 #include "scene.h"
+#include "textures.h" /* unconditionally: the source expander includes each header once */
 
 inline float3 interpolate3(__global const float4* a, uint4 tv, float u, float v) {
   return (1.0f - u - v) * a[tv.x].xyz + u * a[tv.y].xyz + v * a[tv.z].xyz;
 }
 
-/* Emitted radiance of triangle `tri`'s material at barycentrics (u, v), whichever side. */
+inline float4 interpolate4(__global const float4* a, uint4 tv, float u, float v) {
+  return (1.0f - u - v) * a[tv.x] + u * a[tv.y] + v * a[tv.z];
+}
+
+/* Emitted radiance of triangle `tri`'s material at barycentrics (u, v), whichever side:
+ * emissive factor (x strength) x emissive texture. */
 inline float3 material_emission(const SceneView* scene, uint4 tv, float u, float v) {
+  __global const Material* m = scene->materials + tv.w;
+  float3 e = m->emission.xyz;
+#if WP_FEATURE_TEXTURES
+  const int tex = m->textures0.w;
+  if (tex >= 0 && max3(e) > 0.0f)
+    e *= texture_sample(scene, tex, interpolate4(scene->uvs, tv, u, v)).xyz;
+#else
   (void)u;
   (void)v;
-  return scene->materials[tv.w].emission.xyz;
+#endif
+  return e;
+}
+
+#if WP_FEATURE_NORMAL_MAPS
+/* The normal texture's normal at the point, in the front side's frame: the tangent-space normal
+ * (texel * 2 - 1, x and y times the normal scale) in the basis tangent t (the interpolated vertex
+ * tangent made orthogonal to n), bitangent cross(n, t) * w (glTF's convention; w the handedness)
+ * and n, the interpolated vertex normal on the front side. */
+inline float3 normal_mapped(const SceneView* scene, __global const Material* m, uint4 tv, float u,
+                            float v, float4 uv, float3 n) {
+  const float4 t4 = interpolate4(scene->tangents, tv, u, v);
+  float3 t = t4.xyz - n * dot(n, t4.xyz);
+  float3 b;
+  const float len = length(t);
+  if (len > 1e-6f) {
+    t /= len;
+    b = cross(n, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
+  } else {
+    make_basis(n, &t, &b); /* no usable tangent: the map's orientation is lost, not its tilt */
+  }
+  float3 c = texture_sample(scene, m->textures0.z, uv).xyz * 2.0f - 1.0f;
+  c.xy *= m->extra.x;
+  const float3 p = c.x * t + c.y * b + c.z * n;
+  const float lp = length(p);
+  return lp > 0.0f ? p / lp : n;
+}
+
+/* A normal-mapped normal ns can tilt so far from the geometric normal ng that the mirror
+ * reflection of the direction to the viewer wo about it points below the surface, where the BSDF
+ * has nothing to give: strongly tilted texels would turn black (a rasterizer still shows a
+ * reflection there). As Blender Cycles does, bend ns toward ng just enough that this reflection
+ * stays a little above the surface: the result is the half vector between wo and the reflection
+ * lifted to height `lift` above the tangent plane. ns is returned unchanged otherwise. */
+inline float3 keep_reflection_above(float3 ns, float3 ng, float3 wo) {
+  const float3 r = 2.0f * dot(wo, ns) * ns - wo;
+  const float lift = fmin(0.9f * dot(wo, ng), 0.01f);
+  if (dot(r, ng) >= lift) return ns;
+  const float3 rt = r - ng * dot(r, ng); /* the reflection's part in the tangent plane */
+  const float lt = length(rt);
+  if (!(lt > 0.0f)) return ng;
+  return normalize(wo + rt * (sqrt(1.0f - lift * lift) / lt) + lift * ng);
+}
+#endif
+
+/* Base colour, metallic, roughness and transmission: factors x textures x vertex colour. */
+inline void resolve_material(const SceneView* scene, __global const Material* m, uint4 tv, float u,
+                             float v, float4 uv, Surface* s) {
+  float3 color = m->base_color.xyz;
+#if WP_FEATURE_VERTEX_COLORS
+  color *= interpolate3(scene->colors, tv, u, v);
+#endif
+  const float4 q = m->params;
+  s->metallic = q.x;
+  s->roughness = q.y;
+  s->ior = q.z;
+  s->transmission = q.w;
+  s->specular = m->extra.z; /* KHR_materials_specular factor (host/device_scene.cpp packs it) */
+#if WP_FEATURE_TEXTURES
+  const int4 tex = m->textures0;
+  if (tex.x >= 0) color *= texture_sample(scene, tex.x, uv).xyz;
+  if (tex.y >= 0) {
+    const float4 mr = texture_sample(scene, tex.y, uv); /* B: metallic, G: roughness */
+    s->metallic *= mr.z;
+    s->roughness *= mr.y;
+  }
+  if (m->textures1.x >= 0) s->transmission *= texture_sample(scene, m->textures1.x, uv).x;
+#else
+  (void)uv;
+#endif
+  s->color = color;
 }
 
 /* Geometry and material at a hit of a ray with direction ray_d on triangle tv at barycentrics
@@ -31,25 +117,31 @@ inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u, float 
   const float3 p1 = scene->positions[tv.y].xyz;
   const float3 p2 = scene->positions[tv.z].xyz;
   s.p = (1.0f - u - v) * p0 + u * p1 + v * p2;
+  s.p_scale = max3(fabs((1.0f - u - v) * p0) + fabs(u * p1) + fabs(v * p2));
   const float3 n = cross(p1 - p0, p2 - p0);
   const float len = length(n);
   s.ng = len > 0.0f ? n / len : -ray_d; /* a degenerate triangle faces the ray */
   *front = dot(s.ng, ray_d) < 0.0f;
   if (!*front) s.ng = -s.ng;
+#if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS
+  const float4 uv = interpolate4(scene->uvs, tv, u, v);
+#else
+  const float4 uv = (float4)(0.0f);
+#endif
   s.ns = normalize(interpolate3(scene->normals, tv, u, v));
+#if WP_FEATURE_NORMAL_MAPS
+  if (m->textures0.z >= 0) s.ns = normal_mapped(scene, m, tv, u, v, uv, s.ns);
+#endif
+  /* Computed on the front side's frame; turned, like the interpolated normal, to the side the
+   * ray sees (for a back-side hit that mirrors the whole front-side frame). */
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
+#if WP_FEATURE_NORMAL_MAPS
+  if (m->textures0.z >= 0) s.ns = keep_reflection_above(s.ns, s.ng, -ray_d);
+#endif
   /* An interpolated normal can face away from the viewer near silhouettes; shading with it would
    * reflect into the surface. Fall back to the true normal there. */
   if (!(dot(s.ns, -ray_d) > 1e-4f)) s.ns = s.ng;
-  s.color = m->base_color.xyz;
-#if WP_FEATURE_VERTEX_COLORS
-  s.color *= interpolate3(scene->colors, tv, u, v);
-#endif
-  const float4 q = m->params;
-  s.metallic = q.x;
-  s.roughness = q.y;
-  s.ior = q.z;
-  s.transmission = q.w;
+  resolve_material(scene, m, tv, u, v, uv, &s);
   s.flags = *front ? WP_SURF_FRONT : 0u;
 #if WP_FEATURE_UNLIT
   if (m->flags.x & WP_MAT_UNLIT) s.flags |= WP_SURF_UNLIT;

@@ -1,0 +1,85 @@
+/* Texture sampling: a material's TextureRef (shared/types.h) at a point's texture coordinates.
+ *
+ * texture_sample() follows glTF's sampler semantics (those of OpenGL): KHR_texture_transform's
+ * 2x3 matrix on the chosen TEXCOORD set, texel centres at ((i + 0.5) / width, (j + 0.5) / height)
+ * with uv (0, 0) the top-left corner of the image, wrap modes REPEAT, CLAMP_TO_EDGE and
+ * MIRRORED_REPEAT applied per axis to texel indices, and magnification filter NEAREST (the texel
+ * containing the point) or LINEAR (bilinear over the four nearest texel centres). sRGB colour
+ * textures are decoded with the exact sRGB EOTF per texel before filtering, so filtering averages
+ * linear values; alpha is always linear.
+ *
+ * No mipmaps: the minification filter is ignored. A path tracer jitters every sample over its
+ * pixel, so the pixel's average over many samples supersamples the texture and minified textures
+ * converge to their box-filtered footprint instead of aliasing (at the cost of noise at low spp).
+ */
+#ifndef WP_TEXTURES_H
+#define WP_TEXTURES_H
+
+#include "scene.h"
+
+/* The sRGB EOTF (IEC 61966-2-1): encoded value c in [0, 1] to linear. */
+inline float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+}
+
+/* Texel (x, y) of `img` (both in range) as RGBA in [0, 1], decoded to linear when srgb. */
+inline float4 texel_fetch(__global const uint* texels, TextureImage img, int x, int y, bool srgb) {
+  const uint p = texels[img.offset + (uint)y * img.width + (uint)x];
+  float4 c = (float4)((float)(p & 0xffu), (float)((p >> 8) & 0xffu), (float)((p >> 16) & 0xffu),
+                      (float)(p >> 24)) *
+             (1.0f / 255.0f);
+  if (srgb) c.xyz = (float3)(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z));
+  return c;
+}
+
+/* Texel index i (any integer) wrapped into [0, n) by WP_WRAP_* `mode`. */
+inline int wrap_texel(int i, int n, uint mode) {
+  if (mode == WP_WRAP_CLAMP) return clamp(i, 0, n - 1);
+  if (mode == WP_WRAP_MIRROR) {
+    int m = i % (2 * n);
+    if (m < 0) m += 2 * n;
+    return m < n ? m : 2 * n - 1 - m;
+  }
+  int m = i % n;
+  return m < 0 ? m + n : m;
+}
+
+/* A texture coordinate moved by whole wrap periods (1 for REPEAT, 2 for MIRRORED_REPEAT) into a
+ * small range, or clamped just outside [0, 1] for CLAMP_TO_EDGE, so that texel indices computed
+ * from it fit an int; wrap_texel then gives the same texels as for the original coordinate. */
+inline float wrap_reduce(float u, uint mode) {
+  if (mode == WP_WRAP_CLAMP) return clamp(u, -1.0f, 2.0f);
+  if (mode == WP_WRAP_MIRROR) return u - 2.0f * floor(0.5f * u);
+  return u - floor(u);
+}
+
+/* Texture `ref` at the vertex texture coordinates uv01 (xy: TEXCOORD_0, zw: TEXCOORD_1). */
+inline float4 texture_sample(const SceneView* scene, int ref, float4 uv01) {
+  __global const TextureRef* t = scene->textures + ref;
+  const uint4 meta = t->meta;
+  const TextureImage img = scene->images[meta.x];
+  const float2 uv = meta.z == 1u ? uv01.zw : uv01.xy;
+  const float4 ru = t->transform_u, rv = t->transform_v;
+  const uint wrap_s = meta.y & 0xffu, wrap_t = (meta.y >> 8) & 0xffu;
+  const bool srgb = (meta.y & WP_TEX_SRGB) != 0u;
+  const int w = (int)img.width, h = (int)img.height;
+  /* Texel-space position: texel i covers [i, i + 1), its centre at i + 0.5. */
+  const float x = wrap_reduce(ru.x * uv.x + ru.y * uv.y + ru.z, wrap_s) * (float)w;
+  const float y = wrap_reduce(rv.x * uv.x + rv.y * uv.y + rv.z, wrap_t) * (float)h;
+  if (meta.y & WP_TEX_NEAREST) {
+    const int i = wrap_texel((int)floor(x), w, wrap_s), j = wrap_texel((int)floor(y), h, wrap_t);
+    return texel_fetch(scene->texels, img, i, j, srgb);
+  }
+  const float fx = x - 0.5f, fy = y - 0.5f; /* relative to texel centres */
+  const float x0 = floor(fx), y0 = floor(fy);
+  const float ax = fx - x0, ay = fy - y0;
+  const int i0 = wrap_texel((int)x0, w, wrap_s), i1 = wrap_texel((int)x0 + 1, w, wrap_s);
+  const int j0 = wrap_texel((int)y0, h, wrap_t), j1 = wrap_texel((int)y0 + 1, h, wrap_t);
+  const float4 top = mix(texel_fetch(scene->texels, img, i0, j0, srgb),
+                         texel_fetch(scene->texels, img, i1, j0, srgb), ax);
+  const float4 bottom = mix(texel_fetch(scene->texels, img, i0, j1, srgb),
+                            texel_fetch(scene->texels, img, i1, j1, srgb), ax);
+  return mix(top, bottom, ay);
+}
+
+#endif /* WP_TEXTURES_H */
