@@ -1,13 +1,125 @@
 /* The environment: radiance of escaped rays, and its importance sampling for NEE.
  *
- * Without a map (env_width == 0) the environment is the constant background radiance, sampled
- * uniformly over the sphere. With a map: see host/environment.h for the direction convention. */
+ * Without a map (env_width == 0, or a program built with WP_FEATURE_ENVIRONMENT=0) the
+ * environment is the constant background radiance, sampled uniformly over the sphere.
+ *
+ * With a map of W x H = env_width x env_height texels (equirectangular; host/environment.h states
+ * the convention), a world direction d is first turned into the map's frame by the inverse of the
+ * rotation R about +Y (env_params.y, .z = cos R, sin R):
+ *   m = (cos R d.x - sin R d.z, d.y, sin R d.x + cos R d.z),
+ * then u = (atan2(m.x, -m.z) + pi) / (2 pi), v = theta / pi with theta = atan2(|m.xz|, m.y), and
+ * the radiance is texel (floor(u W), floor(v H)) times env_params.x: nearest texel, piecewise
+ * constant over (u, v) like the sampling density.
+ *
+ * Sampling tables (host/environment.cpp fills them), float CDFs:
+ *   env_marginal[0..H]: over rows; [0] = 0, [H] = 1, row y has probability
+ *     P(y) = env_marginal[y+1] - env_marginal[y], proportional to the sum over the row of
+ *     luminance x sin(theta at the row's centre), i.e. to luminance x solid angle.
+ *     All zero for a black map: nothing to sample (env_sample then returns pdf 0, env_pdf is 0).
+ *   env_conditional[y (W+1) + 0..W]: over the columns of row y, [0] = 0, [W] = 1, column x has
+ *     P(x | y) = c[x+1] - c[x], proportional to luminance (uniform in a black row, never chosen).
+ * env_sample picks a row with u.x and a column with u.y (binary search) and a point uniform in the
+ * texel's (u, v) rectangle from the remainders of u.x and u.y within the chosen intervals. Its
+ * density over (u, v) is P(y) P(x | y) W H, computed from the very float differences the search
+ * used, so it is the exact density of the sampling (a texel whose interval rounded to nothing has
+ * density 0 and is left to BSDF sampling). Over solid angle it is divided by the Jacobian
+ * |d omega / du dv| = 2 pi^2 sin(theta); at the poles (sin(theta) = 0, a null set) the pdf is 0. */
 #ifndef WP_ENVIRONMENT_H
 #define WP_ENVIRONMENT_H
 
 #include "scene.h"
 
+#if WP_FEATURE_ENVIRONMENT
+
+#define WP_ENV_BELOW_ONE 0x1.fffffep-1f /* the largest float below 1 */
+
+/* World direction to the map's frame (inverse rotation), and back. */
+inline float3 env_to_map(const SceneDesc* d, float3 w) {
+  const float c = d->env_params.y, s = d->env_params.z;
+  return (float3)(c * w.x - s * w.z, w.y, s * w.x + c * w.z);
+}
+inline float3 env_from_map(const SceneDesc* d, float3 m) {
+  const float c = d->env_params.y, s = d->env_params.z;
+  return (float3)(c * m.x + s * m.z, m.y, -s * m.x + c * m.z);
+}
+
+/* Solid-angle density of a texel chosen with probability p (the product of the table
+ * differences) at a point with sin(theta) = sin_theta. */
+inline float env_texel_pdf(float p, uint w, uint h, float sin_theta) {
+  return sin_theta > 0.0f ? p * ((float)w * (float)h) / (2.0f * WP_PI * WP_PI * sin_theta) : 0.0f;
+}
+
+/* Texel (x, y) seen along map-frame direction m (any length); *sin_theta gets its sin(theta). */
+inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
+  const float r_xz = sqrt(m.x * m.x + m.z * m.z);
+  const float u = fmax(0.0f, atan2(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
+  const float v = atan2(r_xz, m.y) * WP_INV_PI; /* well conditioned at the poles, unlike acos */
+  *sin_theta = r_xz / length(m);
+  return (uint2)(min((uint)(u * (float)d->env_width), d->env_width - 1u),
+                 min((uint)(v * (float)d->env_height), d->env_height - 1u));
+}
+
+/* The interval of CDF cdf[0..n] holding u: the largest i < n with cdf[i] <= u. When
+ * cdf[0] <= u < cdf[n] it is non-empty: cdf[i] <= u < cdf[i+1]. */
+inline uint env_find_interval(__global const float* cdf, uint n, float u) {
+  uint lo = 0u, hi = n; /* cdf[lo] <= u < cdf[hi] */
+  while (hi - lo > 1u) {
+    const uint mid = (lo + hi) >> 1;
+    if (cdf[mid] <= u)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
+  const SceneDesc* d = scene->desc;
+  float sin_theta;
+  const uint2 t = env_texel_of(d, env_to_map(d, dir), &sin_theta);
+  return scene->env_texels[t.y * d->env_width + t.x].xyz * d->env_params.x;
+}
+
+inline float env_map_pdf(const SceneView* scene, float3 dir) {
+  const SceneDesc* d = scene->desc;
+  const uint w = d->env_width;
+  float sin_theta;
+  const uint2 t = env_texel_of(d, env_to_map(d, dir), &sin_theta);
+  __global const float* row = scene->env_conditional + t.y * (w + 1u);
+  const float p =
+      (scene->env_marginal[t.y + 1u] - scene->env_marginal[t.y]) * (row[t.x + 1u] - row[t.x]);
+  return env_texel_pdf(p, w, d->env_height, sin_theta);
+}
+
+inline float3 env_map_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
+  const SceneDesc* d = scene->desc;
+  const uint w = d->env_width, h = d->env_height;
+  __global const float* marginal = scene->env_marginal;
+  *dir = (float3)(0.0f, 1.0f, 0.0f);
+  *pdf = 0.0f;
+  if (!(marginal[h] > 0.0f)) return (float3)(0.0f); /* a black map */
+  const float ux = fmin(u.x, WP_ENV_BELOW_ONE), uy = fmin(u.y, WP_ENV_BELOW_ONE);
+  const uint y = env_find_interval(marginal, h, ux);
+  __global const float* row = scene->env_conditional + y * (w + 1u);
+  const uint x = env_find_interval(row, w, uy);
+  const float p_row = marginal[y + 1u] - marginal[y], p_col = row[x + 1u] - row[x];
+  /* Remainders within the chosen intervals: uniform in [0, 1) given the choice. */
+  const float fy = fmin((ux - marginal[y]) / p_row, WP_ENV_BELOW_ONE);
+  const float fx = fmin((uy - row[x]) / p_col, WP_ENV_BELOW_ONE);
+  const float theta = WP_PI * (((float)y + fy) / (float)h);
+  const float phi = 2.0f * WP_PI * (((float)x + fx) / (float)w) - WP_PI;
+  const float sin_theta = sin(theta);
+  *dir = env_from_map(d, (float3)(sin_theta * sin(phi), cos(theta), -sin_theta * cos(phi)));
+  *pdf = env_texel_pdf(p_row * p_col, w, h, sin_theta);
+  return scene->env_texels[y * w + x].xyz * d->env_params.x;
+}
+
+#endif /* WP_FEATURE_ENVIRONMENT */
+
 inline float3 env_radiance(const SceneView* scene, float3 dir) {
+#if WP_FEATURE_ENVIRONMENT
+  if (scene->desc->env_width > 0u) return env_map_radiance(scene, dir);
+#endif
   (void)dir;
   return scene->desc->background.xyz;
 }
@@ -15,15 +127,22 @@ inline float3 env_radiance(const SceneView* scene, float3 dir) {
 /* Samples a direction toward the environment; returns its radiance, *pdf is the solid-angle
  * density (0 if nothing can be sampled). */
 inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
+#if WP_FEATURE_ENVIRONMENT
+  if (scene->desc->env_width > 0u) return env_map_sample(scene, u, dir, pdf);
+#endif
   const float z = 1.0f - 2.0f * u.x;
   const float r = sqrt(fmax(0.0f, 1.0f - z * z));
   const float phi = 2.0f * WP_PI * u.y;
   *dir = (float3)(r * cos(phi), z, r * sin(phi));
   *pdf = 1.0f / (4.0f * WP_PI);
-  return env_radiance(scene, *dir);
+  return scene->desc->background.xyz;
 }
 
+/* The solid-angle density with which env_sample produces dir. */
 inline float env_pdf(const SceneView* scene, float3 dir) {
+#if WP_FEATURE_ENVIRONMENT
+  if (scene->desc->env_width > 0u) return env_map_pdf(scene, dir);
+#endif
   (void)scene;
   (void)dir;
   return 1.0f / (4.0f * WP_PI);

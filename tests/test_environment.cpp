@@ -1,0 +1,468 @@
+// Environment maps: loading (.hdr, .exr and the refusals), the sampling tables, the direction
+// convention on the device (host/environment.h), and env_sample against env_pdf: chi-square on
+// equal-area sphere bins, pdf agreement per sample, normalisation, and an unbiased estimator of the
+// map's integral over the sphere.
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <random>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+#include <stb_image_write.h>
+#include <gtest/gtest.h>
+
+#include "host/environment.h"
+#include "host/error.h"
+#include "host/light_table.h"
+#include "tests/chi2.h"
+#include "tests/kernel_harness.h"
+#include "tests/test_assets.h"
+
+namespace {
+
+using wp::dev::float4;
+constexpr double kPi = 3.14159265358979323846;
+
+std::string temp_file(const std::string& name) {
+  static const std::string tag = std::to_string(std::random_device{}() % 1000000u);
+  return (std::filesystem::temp_directory_path() / ("wp_env_" + tag + "_" + name)).string();
+}
+
+wp::EnvironmentMap make_map(int w, int h, const std::function<glm::vec3(int, int)>& f) {
+  wp::EnvironmentMap env;
+  env.source = "synthetic";
+  env.width = w;
+  env.height = h;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) env.texels.emplace_back(f(x, y), 0.0f);
+  wp::build_environment_tables(env);
+  return env;
+}
+
+// Host reference of the convention: map coordinates (u, v) of world direction d for a map turned
+// by `degrees` about +Y (the map frame is the world turned back by the rotation).
+glm::dvec2 map_uv(glm::dvec3 d, double degrees) {
+  const double r = degrees * kPi / 180.0, c = std::cos(r), s = std::sin(r);
+  const glm::dvec3 m(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+  return {(std::atan2(m.x, -m.z) + kPi) / (2.0 * kPi), std::acos(m.y / glm::length(m)) / kPi};
+}
+
+// The texel solid angle (2 pi / W)(cos theta_y - cos theta_{y+1}).
+double texel_solid_angle(const wp::EnvironmentMap& env, int y) {
+  const double h = env.height;
+  return 2.0 * kPi / env.width * (std::cos(kPi * y / h) - std::cos(kPi * (y + 1) / h));
+}
+
+// The kernels, built once per test process.
+class Environment : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    kernels_ = std::make_unique<wp::test::KernelHarness>(
+        std::vector<std::string>{"environment_kernels.cl"});
+  }
+  static void TearDownTestSuite() { kernels_.reset(); }
+  static std::unique_ptr<wp::test::KernelHarness> kernels_;
+};
+std::unique_ptr<wp::test::KernelHarness> Environment::kernels_;
+
+// A map on the device: the SceneDesc fields the environment reads, and its three arrays.
+struct DeviceEnv {
+  wp::dev::SceneDesc desc{};
+  cl::Buffer texels, marginal, conditional;
+  DeviceEnv(wp::test::KernelHarness& k, const wp::EnvironmentMap* env, float intensity,
+            double degrees) {
+    const double r = degrees * kPi / 180.0;
+    desc.env_params = {intensity, float(std::cos(r)), float(std::sin(r)), 0.0f};
+    desc.background = {0.25f, 0.5f, 0.75f, 0.0f};
+    const wp::EnvironmentMap none;
+    const wp::EnvironmentMap& e = env ? *env : none;
+    desc.env_width = static_cast<wp::dev::uint>(e.width);
+    desc.env_height = static_cast<wp::dev::uint>(e.height);
+    // A buffer cannot be empty: without a map, one unused element each.
+    texels = k.buffer(e.texels.empty() ? std::vector<glm::vec4>(1) : e.texels);
+    marginal = k.buffer(e.marginal.empty() ? std::vector<float>(1) : e.marginal);
+    conditional = k.buffer(e.conditional.empty() ? std::vector<float>(1) : e.conditional);
+  }
+};
+
+// (env_radiance, env_pdf) of each direction on the device.
+std::vector<float4> eval(wp::test::KernelHarness& k, DeviceEnv& e,
+                         const std::vector<glm::vec3>& dirs) {
+  std::vector<float4> in;
+  for (const glm::vec3& d : dirs) in.push_back({d.x, d.y, d.z, 0.0f});
+  cl::Buffer din = k.buffer(in), out = k.buffer<float4>(in.size());
+  const auto n = static_cast<std::uint32_t>(in.size());
+  k.run("env_eval", n, e.desc, e.texels, e.marginal, e.conditional, din, n, out);
+  return k.read<float4>(out, n);
+}
+
+// ---- Loading ----------------------------------------------------------------------------------
+
+TEST(EnvironmentLoad, HdrRoundTrip) {
+  const int w = 7, h = 3;
+  std::vector<float> rgb;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (float c : {float(x + 1), 0.5f * float(y + 1), 0.125f}) rgb.push_back(c);
+  const std::string path = temp_file("round_trip.hdr");
+  ASSERT_TRUE(stbi_write_hdr(path.c_str(), w, h, 3, rgb.data()));
+  const wp::EnvironmentMap env = wp::load_environment(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(env.width, w);
+  ASSERT_EQ(env.height, h);
+  for (std::size_t i = 0; i < env.texels.size(); ++i) {
+    const float max = std::max({rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]});
+    for (int c = 0; c < 3; ++c)  // RGBE keeps 8 mantissa bits of the largest component
+      EXPECT_NEAR(env.texels[i][c], rgb[3 * i + std::size_t(c)], max / 128.0f) << i << " " << c;
+  }
+  EXPECT_EQ(env.marginal.size(), std::size_t(h + 1));
+  EXPECT_EQ(env.conditional.size(), std::size_t(h * (w + 1)));
+  EXPECT_GT(env.mean_luminance, 0.0);
+}
+
+// Writes an EXR of 32-bit float channels (R, G, B unless told) with a data window that does not
+// start at (0, 0).
+void write_exr(const std::string& path, int w, int h, const std::function<float(int, int, int)>& f,
+               const std::vector<std::string>& channels = {"R", "G", "B"}) {
+  const Imath::Box2i display({0, 0}, {w - 1, h - 1}), data({-3, 5}, {w - 4, h + 4});
+  Imf::Header header(display, data);
+  for (const auto& c : channels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+  std::vector<float> px(std::size_t(w) * std::size_t(h) * channels.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (std::size_t c = 0; c < channels.size(); ++c)
+        px[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * channels.size() + c] =
+            f(x, y, int(c));
+  const std::size_t xs = channels.size() * sizeof(float), ys = xs * std::size_t(w);
+  char* base = reinterpret_cast<char*>(px.data()) + 3 * std::ptrdiff_t(xs) - 5 * std::ptrdiff_t(ys);
+  Imf::FrameBuffer fb;
+  for (std::size_t c = 0; c < channels.size(); ++c)
+    fb.insert(channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+  Imf::OutputFile file(path.c_str(), header);
+  file.setFrameBuffer(fb);
+  file.writePixels(h);
+}
+
+TEST(EnvironmentLoad, ExrDataWindow) {
+  const std::string path = temp_file("window.exr");
+  const auto value = [](int x, int y, int c) {
+    return float(x) + 10.0f * float(y) + 0.25f * float(c);
+  };
+  write_exr(path, 6, 4, value);
+  const wp::EnvironmentMap env = wp::load_environment(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(env.width, 6);
+  ASSERT_EQ(env.height, 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 6; ++x)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(env.texels[std::size_t(y * 6 + x)][c], value(x, y, c)) << x << " " << y;
+}
+
+void expect_refused(const std::string& path, const std::string& why) {
+  try {
+    wp::load_environment(path);
+    ADD_FAILURE() << why << ": " << path << " was accepted";
+  } catch (const wp::Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    std::cout << "  refused (" << why << "): " << e.what() << "\n";
+  }
+}
+
+TEST(EnvironmentLoad, Refusals) {
+  expect_refused(temp_file("missing.hdr"), "missing .hdr");
+  expect_refused(temp_file("missing.exr"), "missing .exr");
+  const std::string text = temp_file("not_an_image.hdr"), text_exr = temp_file("not.exr");
+  const std::string png = temp_file("image.png");
+  for (const std::string& p : {text, text_exr, png}) std::ofstream(p) << "not an image\n";
+  expect_refused(text, "garbage .hdr");
+  expect_refused(text_exr, "garbage .exr");
+  expect_refused(png, "unsupported extension");
+  const std::string bad = temp_file("bad.exr");
+  for (float v : {-1.0f, std::nanf(""), INFINITY}) {
+    write_exr(bad, 4, 2,
+              [v](int x, int y, int c) { return x == 2 && y == 1 && c == 1 ? v : 1.0f; });
+    expect_refused(bad, "value " + std::to_string(v));
+  }
+  write_exr(bad, 4, 2, [](int, int, int) { return 1.0f; }, {"Y"});
+  expect_refused(bad, "no RGB channels");
+  for (const std::string& p : {text, text_exr, png, bad}) std::filesystem::remove(p);
+  wp::EnvironmentMap empty;
+  EXPECT_THROW(wp::build_environment_tables(empty), wp::Error);
+}
+
+// ---- Tables -----------------------------------------------------------------------------------
+
+TEST(EnvironmentTables, ConstantMapMeanAndCdfs) {
+  const glm::vec3 c(1.0f, 2.0f, 4.0f);
+  const wp::EnvironmentMap env = make_map(8, 4, [&](int, int) { return c; });
+  EXPECT_NEAR(env.mean_luminance, 0.2126 * 1 + 0.7152 * 2 + 0.0722 * 4, 1e-12);
+  EXPECT_EQ(env.marginal.front(), 0.0f);
+  EXPECT_EQ(env.marginal.back(), 1.0f);
+  // Rows weigh with sin(theta_c): the marginal is symmetric about the equator.
+  EXPECT_NEAR(env.marginal[2], 0.5f, 1e-7f);
+  const double s1 = std::sin(kPi / 8), s2 = std::sin(3 * kPi / 8);
+  EXPECT_NEAR(env.marginal[1], s1 / (2 * (s1 + s2)), 1e-7);
+  for (int x = 0; x <= 8; ++x) EXPECT_NEAR(env.conditional[std::size_t(9 + x)], x / 8.0, 1e-7);
+}
+
+TEST(EnvironmentTables, BlackRowsAndBlackMap) {
+  const wp::EnvironmentMap rows =
+      make_map(4, 4, [](int x, int y) { return glm::vec3(y == 1 ? 0.0f : float(x + 1)); });
+  EXPECT_EQ(rows.marginal[1], rows.marginal[2]);  // the black row is never chosen
+  EXPECT_EQ(rows.conditional[5 + 4], 1.0f);       // ... but its row table is well-defined
+  const wp::EnvironmentMap black = make_map(4, 2, [](int, int) { return glm::vec3(0.0f); });
+  EXPECT_EQ(black.mean_luminance, 0.0);
+  for (float m : black.marginal) EXPECT_EQ(m, 0.0f);
+  // The light table then gives the environment no light at all (no power, never picked).
+  wp::Scene scene;
+  const wp::LightTable none =
+      wp::build_light_table(scene, &black, glm::vec3(1.0f), 1.0f, wp::LightSelect::kPower);
+  EXPECT_EQ(none.env_light, WP_NO_LIGHT);
+  const wp::LightTable some =
+      wp::build_light_table(scene, &rows, glm::vec3(0.0f), 1.0f, wp::LightSelect::kPower);
+  EXPECT_NE(some.env_light, WP_NO_LIGHT);
+}
+
+// ---- Device: the direction convention ---------------------------------------------------------
+
+// A 9 x 5 map whose texel (x, y) holds (x, y, 1): odd sizes put -Z and the equator at texel
+// centres.
+wp::EnvironmentMap index_map() {
+  return make_map(9, 5, [](int x, int y) { return glm::vec3(float(x), float(y), 1.0f); });
+}
+
+TEST_F(Environment, NamedDirections) {
+  const wp::EnvironmentMap env = index_map();
+  struct Case {
+    double degrees;
+    glm::vec3 dir;
+    int x, y;  // x < 0: any column (a pole)
+  };
+  // u = (atan2(x, -z) + pi) / (2 pi): -Z -> 0.5 (column 4), +X -> 0.75 (6), -X -> 0.25 (2);
+  // v = theta / pi: the equator is row 2, +Y row 0, -Y row 4. Turned by 90 degrees
+  // (counter-clockwise seen from above), the map shows at -X what it showed at -Z, at -Z what it
+  // showed at +X, and at +Z what it showed at -X.
+  const std::vector<Case> cases = {
+      {0, {0, 0, -1}, 4, 2},  {0, {1, 0, 0}, 6, 2},   {0, {-1, 0, 0}, 2, 2},
+      {0, {0, 1, 0}, -1, 0},  {0, {0, -1, 0}, -1, 4}, {90, {-1, 0, 0}, 4, 2},
+      {90, {0, 0, -1}, 6, 2}, {90, {0, 0, 1}, 2, 2},  {90, {0, 1, 0}, -1, 0}};
+  for (const Case& c : cases) {
+    DeviceEnv e(*kernels_, &env, 2.0f, c.degrees);
+    const float4 r = eval(*kernels_, e, {c.dir})[0];
+    const std::string where = "rotation " + std::to_string(c.degrees) + " dir " +
+                              std::to_string(c.dir.x) + "," + std::to_string(c.dir.y) + "," +
+                              std::to_string(c.dir.z);
+    if (c.x >= 0) {
+      EXPECT_EQ(r.x, 2.0f * float(c.x)) << where;
+    }
+    EXPECT_EQ(r.y, 2.0f * float(c.y)) << where;
+    EXPECT_EQ(r.z, 2.0f) << where;
+  }
+}
+
+// Random directions against the host reference: radiance = intensity x the texel of map_uv, and
+// env_pdf = P(row) P(column | row) W H / (2 pi^2 sin theta) from the tables.
+TEST_F(Environment, RandomDirectionsMatchHostReference) {
+  const wp::EnvironmentMap env = make_map(23, 11, [](int x, int y) {
+    return glm::vec3(float(x + 1), float(y * y), float((x * y) % 5));
+  });
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  std::vector<glm::vec3> dirs(4096);
+  for (auto& d : dirs) d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+  for (double degrees : {0.0, 37.0, -150.0}) {
+    DeviceEnv e(*kernels_, &env, 0.5f, degrees);
+    const std::vector<float4> out = eval(*kernels_, e, dirs);
+    int checked = 0;
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      const glm::dvec2 uv = map_uv(dirs[i], degrees);
+      const double fx = uv.x * env.width, fy = uv.y * env.height;
+      if (std::fabs(fx - std::round(fx)) < 1e-4 || std::fabs(fy - std::round(fy)) < 1e-4) continue;
+      const int x = std::min(int(fx), env.width - 1), y = std::min(int(fy), env.height - 1);
+      const glm::vec4 t = env.texels[std::size_t(y * env.width + x)] * 0.5f;
+      EXPECT_EQ(glm::vec3(out[i].x, out[i].y, out[i].z), glm::vec3(t)) << i << " at " << degrees;
+      const std::size_t row = std::size_t(y) * std::size_t(env.width + 1) + std::size_t(x);
+      const double p = double(env.marginal[std::size_t(y) + 1] - env.marginal[std::size_t(y)]) *
+                       double(env.conditional[row + 1] - env.conditional[row]);
+      const double pdf = p * env.width * env.height / (2 * kPi * kPi * std::sin(kPi * uv.y));
+      EXPECT_NEAR(out[i].w, pdf, 1e-5 * pdf) << i << " at " << degrees;
+      ++checked;
+    }
+    EXPECT_GT(checked, 4000);
+  }
+}
+
+struct Draws {
+  std::vector<float4> dir_pdf, radiance_pdf;
+};
+
+Draws draw(wp::test::KernelHarness& k, DeviceEnv& e, std::uint32_t n, std::uint32_t seed) {
+  cl::Buffer a = k.buffer<float4>(n), b = k.buffer<float4>(n);
+  k.run("env_draw", n, e.desc, e.texels, e.marginal, e.conditional, n, seed, a, b);
+  return {k.read<float4>(a, n), k.read<float4>(b, n)};
+}
+
+TEST_F(Environment, ConstantBackgroundAndFeatureOff) {
+  const std::vector<glm::vec3> dirs = {{0, 0, -1}, {0, 1, 0}, {0.6f, 0, 0.8f}};
+  DeviceEnv none(*kernels_, nullptr, 1.0f, 0.0);
+  const wp::EnvironmentMap env = index_map();
+  wp::test::KernelHarness off({"environment_kernels.cl"}, "-D WP_FEATURE_ENVIRONMENT=0");
+  DeviceEnv ignored(off, &env, 2.0f, 0.0);  // compiled out: the map is not looked at
+  for (const auto& out : {eval(*kernels_, none, dirs), eval(off, ignored, dirs)})
+    for (const float4& r : out) {
+      EXPECT_EQ(r.x, 0.25f);
+      EXPECT_EQ(r.y, 0.5f);
+      EXPECT_EQ(r.z, 0.75f);
+      EXPECT_FLOAT_EQ(r.w, float(1.0 / (4.0 * kPi)));
+    }
+}
+
+TEST_F(Environment, BlackMapSamplesNothing) {
+  const wp::EnvironmentMap black = make_map(8, 4, [](int, int) { return glm::vec3(0.0f); });
+  DeviceEnv e(*kernels_, &black, 1.0f, 0.0);
+  const Draws s = draw(*kernels_, e, 1024, 1);
+  for (std::size_t i = 0; i < s.dir_pdf.size(); ++i) {
+    EXPECT_EQ(s.dir_pdf[i].w, 0.0f);
+    EXPECT_EQ(s.radiance_pdf[i].x + s.radiance_pdf[i].y + s.radiance_pdf[i].z, 0.0f);
+  }
+  for (const float4& r : eval(*kernels_, e, {{0, 0, -1}, {0.6f, 0, 0.8f}})) EXPECT_EQ(r.w, 0.0f);
+}
+
+// ---- Device: sampling -------------------------------------------------------------------------
+
+constexpr std::uint32_t kBinsZ = 32, kBinsPhi = 64;
+
+std::size_t bin_of(const float4& d) {
+  const double z = std::clamp(double(d.y), -1.0, 1.0);
+  const double phi = std::atan2(double(d.x), -double(d.z));
+  const auto iz = std::min<std::size_t>(kBinsZ - 1, std::size_t((1.0 - z) / 2.0 * kBinsZ));
+  const auto ip =
+      std::min<std::size_t>(kBinsPhi - 1, std::size_t((phi + kPi) / (2 * kPi) * kBinsPhi));
+  return iz * kBinsPhi + ip;
+}
+
+// env_pdf integrated over each bin on the device (exact for the piecewise-constant density, see
+// the kernel). Their sum is 1 up to float rounding: each piece carries a few float operations of
+// relative error ~1e-7 and the per-bin sums are compensated, so 1e-5 is 10x that bound.
+std::vector<double> bin_probabilities(wp::test::KernelHarness& k, DeviceEnv& e) {
+  const std::uint32_t bins = kBinsZ * kBinsPhi;
+  cl::Buffer out = k.buffer<float>(bins);
+  k.run("env_integrate_bins", bins, e.desc, e.texels, e.marginal, e.conditional, kBinsZ, kBinsPhi,
+        out);
+  const std::vector<float> f = k.read<float>(out, bins);
+  std::vector<double> p(f.begin(), f.end());
+  double total = 0.0;
+  for (double x : p) total += x;
+  EXPECT_NEAR(total, 1.0, 1e-5) << "env_pdf does not integrate to 1";
+  std::cout << "  integral of env_pdf over the sphere: 1 " << std::showpos << total - 1.0
+            << std::noshowpos << "\n";
+  return p;
+}
+
+// env_pdf(dir) must equal the pdf env_sample returned. A direction's round trip through
+// sin/cos/atan2 (and the rotation) can move it across a texel edge by ~1e-7 in u or v (more near
+// a pole, where u is ill-conditioned); only such samples may differ.
+void check_pdf_agreement(const wp::EnvironmentMap& env, double degrees, const Draws& s) {
+  std::size_t differ = 0, off_edge = 0;
+  for (std::size_t i = 0; i < s.dir_pdf.size(); ++i) {
+    const float pdf = s.dir_pdf[i].w, again = s.radiance_pdf[i].w;
+    if (!(pdf > 0.0f) || std::fabs(again - pdf) <= 1e-4f * pdf) continue;
+    ++differ;
+    const glm::dvec3 d(s.dir_pdf[i].x, s.dir_pdf[i].y, s.dir_pdf[i].z);
+    const glm::dvec2 uv = map_uv(d, degrees);
+    const double sin_theta = std::max(1e-6, std::sin(kPi * uv.y));
+    const double du = std::fabs(uv.x * env.width - std::round(uv.x * env.width)) / env.width;
+    const double dv = std::fabs(uv.y * env.height - std::round(uv.y * env.height)) / env.height;
+    if (du > 2e-6 / sin_theta && dv > 2e-6) ++off_edge;
+  }
+  EXPECT_EQ(off_edge, 0u) << "env_pdf disagrees with env_sample away from texel edges";
+  EXPECT_LT(double(differ), 1e-3 * double(s.dir_pdf.size()));
+  std::cout << "  pdf agreement: " << differ << " of " << s.dir_pdf.size()
+            << " samples differ, all at texel edges\n";
+}
+
+// The mean of radiance / pdf estimates the integral of the radiance over the sphere, which for
+// the nearest-texel map is the sum of texel x intensity x texel solid angle.
+void check_estimator(const wp::EnvironmentMap& env, float intensity, const Draws& s) {
+  glm::dvec3 exact(0.0);
+  for (int y = 0; y < env.height; ++y)
+    for (int x = 0; x < env.width; ++x)
+      exact += glm::dvec3(env.texels[std::size_t(y * env.width + x)]) * texel_solid_angle(env, y);
+  exact *= double(intensity);
+  glm::dvec3 sum(0.0), sum2(0.0);
+  for (std::size_t i = 0; i < s.dir_pdf.size(); ++i) {
+    const double pdf = s.dir_pdf[i].w;
+    const glm::dvec3 l(s.radiance_pdf[i].x, s.radiance_pdf[i].y, s.radiance_pdf[i].z);
+    const glm::dvec3 v = pdf > 0.0 ? l / pdf : glm::dvec3(0.0);
+    sum += v;
+    sum2 += v * v;
+  }
+  const double n = double(s.dir_pdf.size());
+  for (int c = 0; c < 3; ++c) {
+    const double mean = sum[c] / n, se = std::sqrt(std::max(0.0, sum2[c] / n - mean * mean) / n);
+    EXPECT_NEAR(mean, exact[c], 5.0 * se) << "channel " << c << " (standard error " << se << ")";
+    std::cout << "  estimator channel " << c << ": " << mean << " vs " << exact[c] << " ("
+              << (mean - exact[c]) / se << " standard errors)\n";
+  }
+}
+
+void check_sampling(wp::test::KernelHarness& k, const wp::EnvironmentMap& env, float intensity,
+                    double degrees, std::uint32_t n) {
+  DeviceEnv e(k, &env, intensity, degrees);
+  const std::vector<double> p = bin_probabilities(k, e);
+  const Draws s = draw(k, e, n, 12345u);
+  std::vector<double> observed(p.size(), 0.0), expected(p.size());
+  for (const float4& d : s.dir_pdf) observed[bin_of(d)] += 1.0;
+  for (std::size_t b = 0; b < p.size(); ++b) expected[b] = p[b] * double(n);
+  const wp::test::Chi2Result r = wp::test::chi2_test(observed, expected);
+  EXPECT_GT(r.p_value, 1e-4) << r.detail;
+  std::cout << "  chi-square: " << r.detail << "\n";
+  check_pdf_agreement(env, degrees, s);
+  check_estimator(env, intensity, s);
+}
+
+// A sky gradient (brighter up and toward +u) with a 2 x 2 texel sun about 10^4 times brighter.
+TEST_F(Environment, SamplingSunAndGradient) {
+  const wp::EnvironmentMap env = make_map(64, 32, [](int x, int y) {
+    if ((x == 40 || x == 41) && (y == 9 || y == 10)) return glm::vec3(2000.0f, 1800.0f, 1500.0f);
+    const float g = (1.2f - float(y) / 32.0f) * (0.5f + float(x) / 64.0f);
+    return glm::vec3(0.4f * g, 0.6f * g, g);
+  });
+  check_sampling(*kernels_, env, 1.5f, 0.0, 1u << 21);
+}
+
+// Odd sizes, a rotation, a black band at the bottom and a black row in the middle, a one-texel
+// sun next to the pole.
+TEST_F(Environment, SamplingRotatedWithBlackRows) {
+  const wp::EnvironmentMap env = make_map(90, 45, [](int x, int y) {
+    if (y >= 40 || y == 20) return glm::vec3(0.0f);
+    if (x == 70 && y == 2) return glm::vec3(1e4f);
+    return glm::vec3(0.1f + float(x % 9), 1.0f, 0.5f + float(y) / 45.0f);
+  });
+  check_sampling(*kernels_, env, 0.7f, 123.0, 1u << 21);
+}
+
+TEST_F(Environment, SamplingRealMap) {
+  const std::filesystem::path path =
+      std::filesystem::path(wp::test::assets_dir()) / "env" / "spiaggia_di_mondello_1k.hdr";
+  if (!std::filesystem::exists(path)) {
+    GTEST_SKIP() << "asset not found: " << path;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const wp::EnvironmentMap env = wp::load_environment(path.string());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "  loaded " << env.width << " x " << env.height << " with tables in " << seconds
+            << " s\n";
+  check_sampling(*kernels_, env, 1.0f, 30.0, 1u << 21);
+}
+
+}  // namespace
