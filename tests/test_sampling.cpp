@@ -1,0 +1,479 @@
+// Tier 3: every sampling routine against its own density, on the OpenCL device (PoCL in CI).
+//
+// Per configuration, tests/kernels/sampling_kernels.cl draws kSamples directions and integrates
+// the density that the routine's eval side gives (cosine_hemisphere_pdf, ggx_reflection_pdf,
+// bsdf_eval, triangle_light_pdf) over bins of the sphere (tests/sphere_bins.h). Checks:
+// - chi-square (tests/chi2.h): the histogram of non-delta samples against the integrals, scaled
+//   to the number of such samples (so it tests the shape; the mass is the next check); p > 1e-4;
+// - mass: the integral of the pdf over the sphere equals the observed fraction of non-delta
+//   samples (1 - invalid - delta) within 5 binomial sigma plus the integration's own error;
+//   where every sample must be valid and none delta, the integral is 1 and nothing is invalid;
+// - pointwise: each sample's pdf equals the eval side's at its direction and a BSDF weight equals
+//   f |cos| / pdf (relative 1e-4); delta samples lie on the exact mirror/refraction direction.
+//
+// False alarms: a correct routine fails one configuration's chi-square with probability 1e-4 (the
+// 5-sigma checks add ~1e-6); over the 140 configurations here that is at most 1.4% (union bound)
+// for a random choice of seeds. Seeds are fixed, so a given build on a given device passes or
+// fails reproducibly; a change of the random stream (new code, another device's rounding) draws
+// anew from that 1.4%.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "host/light_table.h"
+#include "kernels/shared/types.h"
+#include "tests/chi2.h"
+#include "tests/kernel_harness.h"
+#include "tests/sphere_bins.h"
+
+namespace {
+
+using wp::dev::float4;
+using wp::test::BinRect;
+using wp::test::SphereBins;
+
+constexpr std::uint32_t kSamples = 1u << 20;
+constexpr double kPi = SphereBins::kPi;
+constexpr std::uint32_t kVolume = 2u, kFront = 4u;  // WP_SURF_VOLUME, WP_SURF_FRONT (bsdf.h)
+
+// Binning: a 32 x 64 base grid; base bins expected to hold more than kTargetPerBin samples are
+// split into up to kMaxSplit^2 parts of about that many, so that narrow lobes (roughness 0.1:
+// GGX alpha 0.01, a lobe ~0.02 rad wide) still spread over several bins.
+constexpr int kBaseC = 32, kBasePhi = 64, kMaxSplit = 24;
+constexpr double kTargetPerBin = 2000.0;
+
+// Integration per bin (integrate_pdf): from n0 x n0 points, doubled up to max_level times until
+// the last two changes are within 1e-3 relative (the error is then far smaller on smooth
+// integrands: a bias of at most ~(1e-3)^2 N = 1 in a chi-square with >1000 degrees of freedom) or
+// 1e-8 absolute (0.01 samples).
+struct Quadrature {
+  std::uint32_t n0, max_level;
+};
+constexpr Quadrature kSmooth = {2, 7};  // 2 .. 256 points per axis
+// The triangle's pdf jumps at its edges, which cut bins anywhere: start finer, so that a thin
+// part of a bin on one side of an edge is not missed by three coarse levels alike.
+constexpr Quadrature kEdges = {8, 5};  // 8 .. 256
+// Bins whose integral came out 0 but which hold samples are integrated again with many more
+// points: there the points missed a sliver of the support. Expected counts stay functions of the
+// pdf alone, computed more carefully where it matters; a sample outside the support is caught by
+// the pointwise pdf check. More than kMaxRescued such bins means samples outside the support,
+// not slivers: the chi-square fails on them without the (slow) second look.
+constexpr Quadrature kRescue = {128, 2};  // 128 .. 512
+constexpr std::size_t kMaxRescued = 64;
+constexpr float kIntegralRelTol = 1e-3f, kIntegralAbsTol = 1e-8f;
+
+enum Routine : std::uint32_t { kCosine = 0, kGgx = 1, kBsdf = 2, kTriangle = 3 };  // ST_* (.cl)
+// How the bins lie (BF_* in the .cl, the mapping in sphere_bins.h): the pole on the horizon keeps
+// lobes of the plane of incidence away from the poles and the horizon on bin edges; the pole on
+// the normal puts each circle of constant z - the GGX reflection's support ends at z = -v.z - on
+// bin edges when z is a multiple of 1/16.
+enum Frame : std::uint32_t { kPoleOnHorizon = 0, kPoleOnNormal = 1 };
+
+// One configuration of a routine; the fields' meaning per routine is in sampling_kernels.cl.
+struct Config {
+  std::string name;
+  std::uint32_t routine = kCosine, frame = kPoleOnHorizon, flags = 0;
+  float4 a{}, color{}, params{};
+  // ST_TRIANGLE: counter-clockwise seen from the origin, so its front faces the shading point;
+  // the vertices lie off the bins' grid lines (a vertex on one makes a sliver that only rounding
+  // reaches).
+  std::vector<float4> triangle = {{-1.1f, -0.9f, 1, 1}, {0.1f, 1.05f, 1, 1}, {0.95f, -1.05f, 1, 1}};
+  bool double_sided = false;
+  bool all_valid = false;  // every sample valid and non-delta: the pdf integrates to 1
+  Quadrature quadrature = kSmooth;
+};
+
+float4 direction(double cos_theta) {  // in the x-z plane
+  return {static_cast<float>(std::sqrt(1.0 - cos_theta * cos_theta)), 0.0f,
+          static_cast<float>(cos_theta), 0.0f};
+}
+double cos_deg(double deg) {
+  return std::cos(deg * kPi / 180.0);
+}
+
+std::uint32_t seed_of(const std::string& name) {  // FNV-1a: a fixed stream per configuration
+  std::uint32_t h = 2166136261u;
+  for (unsigned char ch : name) h = (h ^ ch) * 16777619u;
+  return h;
+}
+
+struct Draw {
+  std::vector<float4> dirs, checks;  // see draw_samples in sampling_kernels.cl
+  std::size_t smooth = 0, delta = 0, invalid = 0;
+  std::size_t below = 0, delta_below = 0;  // valid samples below the surface (local z < 0)
+  double pdf_error = 0, weight_error = 0, third_error = 0;  // maxima of checks' x, y, z
+};
+
+struct Integrals {
+  explicit Integrals(std::size_t n) : value(n, 0.0), error(n, 0.0) {}
+  std::vector<double> value, error;  // per bin
+};
+
+// The test kernels, built once per process, and the sample buffers every draw reuses.
+class Device {
+ public:
+  static Device& get() {
+    static Device d;
+    return d;
+  }
+
+  Draw draw(const Config& c) {
+    run(c, "draw_samples", kSamples, seed_of(c.name), kSamples, dirs_, checks_);
+    Draw d;
+    d.dirs = h_.read<float4>(dirs_, kSamples);
+    d.checks = h_.read<float4>(checks_, kSamples);
+    for (std::size_t i = 0; i < kSamples; ++i) {
+      const float4 v = d.dirs[i], k = d.checks[i];
+      if (v.w == 0.0f) {
+        ++d.invalid;
+        continue;
+      }
+      (v.w == 1.0f ? d.smooth : d.delta) += 1;
+      d.below += v.z < 0.0f;
+      d.delta_below += v.z < 0.0f && v.w == 2.0f;
+      d.pdf_error = std::max(d.pdf_error, static_cast<double>(k.x));
+      d.weight_error = std::max(d.weight_error, static_cast<double>(k.y));
+      d.third_error = std::max(d.third_error, static_cast<double>(k.z));
+    }
+    return d;
+  }
+
+  // Integrals of c's pdf over `rects` (value, error estimate), stored at out[at[k]] for rect k.
+  void integrate(const Config& c, const std::vector<BinRect>& rects, Quadrature q,
+                 const std::vector<std::size_t>& at, Integrals& out) {
+    if (rects.empty()) return;
+    std::vector<float4> r;
+    for (const BinRect& b : rects)
+      r.push_back({static_cast<float>(b.c0), static_cast<float>(b.c1), static_cast<float>(b.phi0),
+                   static_cast<float>(b.phi1)});
+    const auto count = static_cast<std::uint32_t>(r.size());
+    cl::Buffer in = h_.buffer(r), result = h_.buffer<cl_float2>(count);
+    run(c, "integrate_pdf", count, in, count, q.n0, kIntegralRelTol, kIntegralAbsTol, q.max_level,
+        result);
+    const auto v = h_.read<cl_float2>(result, count);
+    for (std::size_t k = 0; k < count; ++k) {
+      out.value[at[k]] = v[k].s[0];
+      out.error[at[k]] = v[k].s[1];
+    }
+  }
+
+  // bsdf_lobes at the configuration's wo: {specular, transmission, diffuse}.
+  std::vector<float> lobes(const Config& c) {
+    cl::Buffer out = h_.buffer<float>(3);
+    run(c, "lobe_selection", 1, out);
+    return h_.read<float>(out, 3);
+  }
+
+  wp::test::KernelHarness& harness() { return h_; }
+
+ private:
+  Device() : h_({"sampling_kernels.cl"}) {
+    dirs_ = h_.buffer<float4>(std::size_t{kSamples});
+    checks_ = h_.buffer<float4>(std::size_t{kSamples});
+  }
+
+  // Runs `kernel` with the configuration's arguments (WP_CONFIG_PARAMS) followed by `rest`; the
+  // one-triangle scene (light 0, pmf 1, emission 1) is rebuilt from the configuration each time.
+  template <class... Rest>
+  void run(const Config& c, const char* kernel, std::size_t items, Rest&&... rest) {
+    wp::dev::Material m{};
+    m.emission = {1, 1, 1, 0};
+    m.flags.x = c.double_sided ? WP_MAT_DOUBLE_SIDED : 0u;
+    m.textures0 = m.textures1 = {-1, -1, -1, -1};
+    const std::vector<wp::dev::uint4> tri_vertices = {{0, 1, 2, 0}};
+    const std::vector<wp::dev::LightAlias> alias = {{1.0f, 0u, 1.0f, 0u}};
+    h_.run(kernel, items, c.routine, c.frame, c.flags, c.a, c.color, c.params,
+           h_.buffer(c.triangle), h_.buffer(tri_vertices),
+           h_.buffer(std::vector<wp::dev::Material>{m}), h_.buffer(std::vector<std::uint32_t>{0u}),
+           h_.buffer(alias), std::forward<Rest>(rest)...);
+  }
+
+  wp::test::KernelHarness h_;
+  cl::Buffer dirs_, checks_;
+};
+
+std::vector<std::size_t> iota(std::size_t n) {
+  std::vector<std::size_t> v(n);
+  std::iota(v.begin(), v.end(), std::size_t{0});
+  return v;
+}
+
+// Bins for configuration c, chosen from its pdf, never from the samples: the base grid, each bin
+// split where its integral says the density is high. Returns the integrals over the final bins.
+Integrals make_bins(const Config& c, SphereBins& bins) {
+  const auto base_count = static_cast<std::size_t>(bins.base_count());
+  Integrals base(base_count);
+  Device::get().integrate(c, bins.rects(), c.quadrature, iota(base_count), base);
+  std::vector<int> split(base_count);
+  for (std::size_t b = 0; b < base_count; ++b) {
+    const double parts = std::ceil(std::sqrt(kSamples * base.value[b] / kTargetPerBin));
+    split[b] = static_cast<int>(std::clamp(parts, 1.0, double{kMaxSplit}));
+  }
+  bins.refine(split);
+  const std::vector<BinRect> rects = bins.rects();
+  Integrals in(bins.size());
+  std::vector<BinRect> parts;
+  std::vector<std::size_t> at;
+  for (std::size_t b = 0; b < base_count; ++b) {
+    const std::size_t first = bins.first_of(b), m = static_cast<std::size_t>(split[b]);
+    if (m == 1) {
+      in.value[first] = base.value[b], in.error[first] = base.error[b];
+      continue;
+    }
+    for (std::size_t k = first; k < first + m * m; ++k) parts.push_back(rects[k]), at.push_back(k);
+  }
+  Device::get().integrate(c, parts, c.quadrature, at, in);
+  return in;
+}
+
+struct Fit {
+  double total = 0.0, total_error = 0.0;  // of the pdf's integrals over the bins
+  wp::test::Chi2Result chi2;
+};
+
+// The chi-square of the non-delta samples' histogram against c's pdf integrated over its bins.
+Fit fit(const Config& c, const Draw& d) {
+  SphereBins bins(kBaseC, kBasePhi);
+  Integrals in = make_bins(c, bins);
+  const std::vector<BinRect> rects = bins.rects();
+  std::vector<double> observed(bins.size(), 0.0), expected(bins.size(), 0.0);
+  for (const float4& v : d.dirs) {
+    if (v.w != 1.0f) continue;
+    const bool pole_z = c.frame == kPoleOnNormal;  // see sphere_bins.h for the mapping
+    observed[pole_z ? bins.bin_of(v.x, v.z, v.y) : bins.bin_of(v.x, v.y, v.z)] += 1.0;
+  }
+  std::vector<BinRect> again;
+  std::vector<std::size_t> again_at;
+  for (std::size_t b = 0; b < bins.size(); ++b)
+    if (in.value[b] <= 0.0 && observed[b] > 0.0) again.push_back(rects[b]), again_at.push_back(b);
+  if (again.size() <= kMaxRescued) Device::get().integrate(c, again, kRescue, again_at, in);
+  Fit f;
+  f.total = std::accumulate(in.value.begin(), in.value.end(), 0.0);
+  f.total_error = std::accumulate(in.error.begin(), in.error.end(), 0.0);
+  const double scale = f.total > 0.0 ? static_cast<double>(d.smooth) / f.total : 0.0;
+  for (std::size_t b = 0; b < bins.size(); ++b) expected[b] = in.value[b] * scale;
+  f.chi2 = wp::test::chi2_test(observed, expected);
+  return f;
+}
+
+double binomial_sigma(double p, double n) {
+  return std::sqrt(std::max(p * (1.0 - p), 1.0 / n) / n);
+}
+
+// Rounding in the pdf itself: GGX's D(h) depends on 1 - (n.h)^2, ~alpha^2 at the lobe's peak, and
+// n.h (from dot products and a normalisation) carries ~6e-8 of rounding, so D's relative error
+// there is ~4 * 6e-8 / alpha^2: 2.4e-3 for roughness 0.1 (alpha 0.01) with a tilted normal.
+double pdf_rounding(const Config& c) {
+  const double alpha = c.routine == kGgx    ? c.a.w
+                       : c.routine == kBsdf ? c.params.y * c.params.y
+                                            : 0.0;
+  return alpha > 1e-4 ? 2.4e-7 / (alpha * alpha) : 0.0;
+}
+
+// Draws configuration c and applies the checks listed at the top of the file. Returns the draw
+// for further checks by the caller.
+Draw check_config(const Config& c) {
+  SCOPED_TRACE(c.name);
+  const Draw d = Device::get().draw(c);
+  const Fit f = fit(c, d);
+  const double n = kSamples, smooth = static_cast<double>(d.smooth) / n;
+  // Integration error: 3x the sum of the per-bin estimates (on smooth integrands each is many
+  // times its bin's error; where a bin cuts an edge of the triangle the error can be a few times
+  // the last change), 1e-5 for float rounding in the device's sums, and the pdf's own rounding.
+  const double tol = 3.0 * f.total_error + 1e-5 + pdf_rounding(c);
+  EXPECT_NEAR(f.total, smooth, 5.0 * binomial_sigma(smooth, n) + tol) << "pdf mass vs samples";
+  if (c.all_valid) {
+    EXPECT_EQ(d.invalid + d.delta, 0u);
+    EXPECT_NEAR(f.total, 1.0, tol);
+  }
+  if (d.smooth > 0) {
+    EXPECT_GT(f.chi2.p_value, 1e-4) << f.chi2.detail;
+  }
+  // GGX: the eval side rebuilds h from l = reflect(v, h); where v + l is short (grazing v) that
+  // loses a few bits, and D(h) of a small alpha is steep.
+  EXPECT_LE(d.pdf_error, c.routine == kGgx ? 1e-2 : 1e-4) << "sampled pdf vs eval pdf";
+  EXPECT_LE(d.weight_error, 1e-4) << "weight vs f |cos| / pdf";
+  EXPECT_LE(d.third_error, c.routine == kTriangle ? 1e-4 : 1e-5)
+      << (c.routine == kTriangle ? "distance vs ray hit" : "delta direction");
+  std::printf("%-36s smooth %.4f delta %.4f invalid %.4f | int %.5f +- %.1e | %s\n", c.name.c_str(),
+              smooth, static_cast<double>(d.delta) / n, static_cast<double>(d.invalid) / n, f.total,
+              tol, d.smooth > 0 ? f.chi2.detail.c_str() : "no density to test");
+  std::fflush(stdout);
+  return d;
+}
+
+Config bsdf_config(float metallic, float roughness, float4 color, double view_deg,
+                   float transmission = 0.0f, std::uint32_t flags = kFront) {
+  char name[96];
+  std::snprintf(name, sizeof name, "bsdf m%.1f r%.1f c(%.1f,%.1f,%.2f) t%.1f f%u v%.0f", metallic,
+                roughness, color.x, color.y, color.z, transmission, flags, view_deg);
+  Config c{name, kBsdf, kPoleOnHorizon, flags};
+  c.a = direction(cos_deg(view_deg));
+  c.color = color;
+  c.params = {metallic, roughness, 1.5f, transmission};
+  return c;
+}
+
+// A BSDF configuration: check_config, then the lobe choice. A smooth surface (roughness 0) has
+// delta lobes for specular reflection and transmission, chosen with bsdf_lobes' probabilities, so
+// the fractions of delta samples above and below the surface must match them; a rough one has no
+// delta samples. Nothing goes below a surface that does not transmit.
+void check_bsdf(const Config& c) {
+  const Draw d = check_config(c);
+  SCOPED_TRACE(c.name);
+  const std::vector<float> lobes = Device::get().lobes(c);
+  const double n = kSamples, spec = lobes[0], trans = lobes[1];
+  if (c.params.y <= 0.01f) {  // WP_DELTA_ROUGHNESS
+    EXPECT_NEAR(static_cast<double>(d.delta - d.delta_below) / n, spec,
+                5.0 * binomial_sigma(spec, n));
+    EXPECT_NEAR(static_cast<double>(d.delta_below) / n, trans, 5.0 * binomial_sigma(trans, n));
+  } else {
+    EXPECT_EQ(d.delta, 0u);
+  }
+  if (trans == 0.0) {
+    EXPECT_EQ(d.below, 0u);
+  } else if (trans > 0.01) {
+    EXPECT_GT(d.below, 0u);
+  }
+}
+
+const float4 kWhite = {1, 1, 1, 0}, kSaturated = {0.9f, 0.1f, 0.02f, 0};
+
+TEST(Sampling, CosineHemisphere) {
+  Config c{"cosine hemisphere", kCosine};
+  c.all_valid = true;
+  check_config(c);
+}
+
+// Reflection about visible GGX normals: a density over the whole sphere (below-horizon
+// reflections included), so it integrates to 1 at every view angle. Its support ends where the
+// microfacet normal reaches the horizon, z = -v.z, a jump in the pdf: the view angles have
+// v.z = k/16, so that circle is a bin edge (acos(1/16) = 86.4 degrees: grazing).
+TEST(Sampling, GgxVisibleNormalReflection) {
+  for (float alpha : {0.05f, 0.1f, 0.3f, 0.6f, 1.0f})
+    for (int k : {16, 12, 8, 4, 1}) {
+      char name[64];
+      std::snprintf(name, sizeof name, "ggx alpha %.2f v.z %d/16", alpha, k);
+      Config c{name, kGgx, kPoleOnNormal};
+      c.a = direction(k / 16.0);
+      c.a.w = alpha;
+      c.all_valid = true;
+      check_config(c);
+    }
+}
+
+TEST(Sampling, GltfBrdf) {
+  for (float metallic : {0.0f, 0.5f, 1.0f})
+    for (float roughness : {0.1f, 0.3f, 0.6f, 1.0f})
+      for (float4 color : {kWhite, kSaturated})
+        for (double view : {0.0, 45.0, 80.0})
+          check_bsdf(bsdf_config(metallic, roughness, color, view));
+}
+
+// Roughness 0: the specular layer is a delta lobe; bsdf_eval's pdf is then the diffuse part
+// alone, and metallic 1 leaves nothing but the delta lobe.
+TEST(Sampling, GltfBrdfSmoothSpecular) {
+  for (float metallic : {0.0f, 0.5f, 1.0f})
+    for (float4 color : {kWhite, kSaturated})
+      for (double view : {0.0, 45.0, 80.0}) check_bsdf(bsdf_config(metallic, 0.0f, color, view));
+}
+
+// Dielectric transmission (KHR_materials_transmission, ior 1.5), thin-walled and with a volume
+// (KHR_materials_volume). "Inside" is what bsdf.h's Surface says: the normals always face wo, and
+// WP_SURF_FRONT is clear on a WP_SURF_VOLUME surface when the ray arrived on the back side, from
+// inside (relative ior 1 / 1.5; total internal reflection from 41.8 degrees on). Add a
+// configuration by adding a line.
+TEST(Sampling, DielectricTransmission) {
+  const std::vector<Config> configs = {
+      bsdf_config(0, 0.0f, kWhite, 30, 1, kFront),  // thin-walled
+      bsdf_config(0, 0.3f, kWhite, 30, 1, kFront),
+      bsdf_config(0, 0.7f, kWhite, 30, 1, kFront),
+      bsdf_config(0, 0.3f, kWhite, 75, 1, kFront),
+      bsdf_config(0, 0.0f, kWhite, 30, 1, kVolume | kFront),  // entering the volume
+      bsdf_config(0, 0.3f, kWhite, 30, 1, kVolume | kFront),
+      bsdf_config(0, 0.7f, kWhite, 30, 1, kVolume | kFront),
+      bsdf_config(0, 0.3f, kWhite, 75, 1, kVolume | kFront),
+      bsdf_config(0, 0.0f, kWhite, 30, 1, kVolume),  // leaving it
+      bsdf_config(0, 0.3f, kWhite, 30, 1, kVolume),
+      bsdf_config(0, 0.7f, kWhite, 30, 1, kVolume),
+      bsdf_config(0, 0.0f, kWhite, 60, 1, kVolume),  // beyond the critical angle
+      bsdf_config(0, 0.3f, kWhite, 60, 1, kVolume),
+      bsdf_config(0, 0.7f, kWhite, 60, 1, kVolume),
+      bsdf_config(0.5f, 0.3f, kSaturated, 30, 0.5f, kVolume | kFront),  // every lobe at once
+      bsdf_config(0, 0.0f, kSaturated, 45, 0.5f, kFront),
+  };
+  for (const Config& c : configs) check_bsdf(c);
+}
+
+// An emitting triangle seen from the origin (the shading point), binned around it.
+TEST(Sampling, TriangleLight) {
+  Config front{"triangle front", kTriangle};
+  front.all_valid = true;
+  front.quadrature = kEdges;
+  Config near = front;  // large in view and oblique: the pdf varies ~10x over it
+  near.name = "triangle near, oblique";
+  near.triangle = {{-2, -0.5f, 0.3f, 1}, {0, 2, 0.2f, 1}, {3, -1, 0.5f, 1}};
+  Config back_two = front;  // seen from behind, double-sided: emits toward the origin too
+  back_two.name = "triangle back, double-sided";
+  back_two.triangle = {front.triangle[0], front.triangle[2], front.triangle[1]};
+  back_two.double_sided = true;
+  Config back_one = back_two;  // seen from behind, single-sided: nothing valid
+  back_one.name = "triangle back, single-sided";
+  back_one.double_sided = false;
+  back_one.all_valid = false;
+  for (const Config& c : {front, near, back_two}) check_config(c);
+  const Draw d = check_config(back_one);
+  EXPECT_EQ(d.invalid, kSamples);
+}
+
+// Light picking from an alias table over uneven weights (zeros included): frequencies against
+// the pmf by chi-square, zero-weight lights never picked, and each pick's reported pmf equal to
+// weight / total.
+TEST(Sampling, LightPick) {
+  std::vector<double> many(1000);
+  for (std::size_t i = 0; i < many.size(); ++i)  // log-uniform over 4 decades, every 7th zero
+    many[i] =
+        i % 7 == 3 ? 0.0 : std::pow(10.0, 4.0 * std::fmod(0.618034 * static_cast<double>(i), 1.0));
+  const std::vector<std::vector<double>> tables = {
+      {1.0}, {0, 5, 0.5, 0, 20, 1, 1, 1e-3, 3, 0}, {0, 0, 1}, many};
+  auto& h = Device::get().harness();
+  cl::Buffer chosen = h.buffer<std::uint32_t>(std::size_t{kSamples});
+  cl::Buffer pmfs = h.buffer<float>(std::size_t{kSamples});
+  for (std::size_t t = 0; t < tables.size(); ++t) {
+    SCOPED_TRACE("table " + std::to_string(t));
+    const std::vector<double>& w = tables[t];
+    const double total = std::accumulate(w.begin(), w.end(), 0.0);
+    const auto alias = wp::build_alias_table(w);
+    h.run("pick_lights", kSamples, static_cast<std::uint32_t>(w.size()), h.buffer(alias),
+          seed_of("pick" + std::to_string(t)), kSamples, chosen, pmfs);
+    const auto idx = h.read<std::uint32_t>(chosen, kSamples);
+    const auto pmf = h.read<float>(pmfs, kSamples);
+    std::vector<double> observed(w.size(), 0.0), expected(w.size());
+    double pmf_error = 0.0;
+    for (std::size_t i = 0; i < kSamples; ++i) {
+      ASSERT_LT(idx[i], w.size());
+      observed[idx[i]] += 1.0;
+      const double p = w[idx[i]] / total;  // 0: caught below as observed_outside
+      if (p > 0.0) pmf_error = std::max(pmf_error, std::fabs(pmf[i] - p) / p);
+    }
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      expected[i] = kSamples * w[i] / total;
+      EXPECT_NEAR(alias[i].pmf, w[i] / total, 1e-6 * w[i] / total) << "light " << i;
+    }
+    const auto r = wp::test::chi2_test(observed, expected);
+    EXPECT_EQ(r.observed_outside, 0.0) << "a zero-weight light was picked";
+    if (w.size() > 1) {
+      EXPECT_GT(r.p_value, 1e-4) << r.detail;
+    }
+    EXPECT_LE(pmf_error, 1e-6) << "reported pmf vs weight / total";
+    std::printf("pick table %zu (%zu lights): %s\n", t, w.size(), r.detail.c_str());
+  }
+}
+
+}  // namespace
