@@ -1,9 +1,10 @@
 // Internal to bvh/: the intermediate tree that Embree's generic builder (rtcBuildBVH) produces
 // through our callbacks, before it is flattened into a device layout.
 //
-// The tree is N-ary (up to kMaxBranching children per inner node) so that the same build can feed
-// layouts of different widths; build() in bvh_build.cpp asks for a binary one. All nodes live in
-// memory owned by the RTCBVH inside EmbreeTree and die with it.
+// The tree is N-ary (up to kMaxBranching children per inner node) so that the same build feeds
+// both layouts: build() in bvh_build.cpp asks Embree for options.width children per node and
+// hands the tree to flatten_binary (bvh_build.cpp) or flatten_wide (bvh_flatten_wide.cpp). All
+// nodes live in memory owned by the RTCBVH inside EmbreeTree and die with it.
 #pragma once
 
 #include <cstddef>
@@ -30,6 +31,35 @@ inline float surface_area(const Box& b) {
   return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+// What both layouts store of scene triangle `index`: v0, e1 = v1 - v0, e2 = v2 - v0 and its
+// WP_TRI_* flags (0 without BuildInput::triangle_flags).
+struct StoredTriangle {
+  glm::vec3 v0, e1, e2;
+  std::uint32_t flags;
+};
+inline StoredTriangle stored_triangle(const BuildInput& input, std::uint32_t index) {
+  const std::uint32_t* idx = input.indices + 3 * static_cast<std::size_t>(index);
+  const glm::vec3 v0 = input.positions[idx[0]];
+  return StoredTriangle{v0, input.positions[idx[1]] - v0, input.positions[idx[2]] - v0,
+                        input.triangle_flags ? input.triangle_flags[index] : 0u};
+}
+
+// The surface-area ratio A(b) / A(root) of BuildStats::sah_cost; a flat or point-like root
+// (A(root) = 0) counts every ratio as 1.
+class AreaRatio {
+ public:
+  explicit AreaRatio(const Box& root) {
+    const double a = surface_area(root);
+    inv_root_ = a > 0 ? 1.0 / a : 0.0;
+  }
+  double operator()(const Box& b) const {
+    return inv_root_ > 0 ? surface_area(b) * inv_root_ : 1.0;
+  }
+
+ private:
+  double inv_root_ = 0;
+};
+
 struct TreeNode {
   bool is_leaf;
 };
@@ -41,7 +71,7 @@ struct TreeInner : TreeNode {
 };
 
 struct TreeLeaf : TreeNode {
-  unsigned count;              // 1..max_leaf_size
+  unsigned count;              // 1..max_leaf_size (Embree 3.13 keeps to it: embree_tree.cpp)
   const std::uint32_t* prims;  // `count` scene triangle indices
   Box bounds;                  // union of the references' (possibly clipped) boxes
 };
@@ -59,10 +89,17 @@ struct EmbreeTree {
 };
 
 // Validates `input` and `options` (throws wp::Error naming the first problem) and runs Embree's
-// builder with at most `branching` children per node. Leaves hold up to options.max_leaf_size
+// builder with at most options.width children per node. Leaves hold up to options.max_leaf_size
 // references; with options.spatial_splits a triangle may be referenced by several leaves.
-EmbreeTree build_embree_tree(const BuildInput& input, const BuildOptions& options,
-                             unsigned branching);
+EmbreeTree build_embree_tree(const BuildInput& input, const BuildOptions& options);
+
+// The flatteners: fill out.nodes/triangles (binary; the tree must be binary) or out.nodes8/blocks
+// (8-wide; any tree with 2..8 children per node, leaves of any size) and out.stats except
+// build_seconds. `scene` is the root's box; out.lo/hi and out.width are the caller's.
+void flatten_binary(const TreeNode& root, const Box& scene, const BuildInput& input,
+                    const BuildOptions& options, Bvh& out);
+void flatten_wide(const TreeNode& root, const Box& scene, const BuildInput& input,
+                  const BuildOptions& options, Bvh& out);
 
 // The spatial-split clipper: the part of triangle `v` inside `box` is cut by the plane
 // x[dim] = pos, and `left`/`right` receive the bounds of the parts with x[dim] <= pos and

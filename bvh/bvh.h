@@ -1,6 +1,6 @@
-// The BVH: built on the host with Embree's generic builder (rtcBuildBVH), flattened into the
-// device layout of kernels/shared/bvh_layout.h, plus a CPU reference traversal of that very
-// layout for tests.
+// The BVH: built on the host with Embree's generic builder (rtcBuildBVH), flattened into one of
+// the two device layouts of kernels/shared/bvh_layout.h (binary for GPUs, 8-wide for CPU devices),
+// plus a CPU reference traversal of each layout for tests.
 #pragma once
 
 #include <cstddef>
@@ -15,12 +15,17 @@
 namespace wp::bvh {
 
 struct BuildOptions {
+  // The layout: 2 (BvhNode + IsectTri) or 8 (BvhNode8 + TriBlock4); anything else is an error.
+  int width = 2;
   // Embree's RTC_BUILD_QUALITY_HIGH with spatial splits (SBVH-like): triangles may then be
   // referenced by more than one leaf. Off: binned SAH (RTC_BUILD_QUALITY_MEDIUM), one reference
   // each.
   bool spatial_splits = false;
-  int max_leaf_size = WP_BVH_MAX_LEAF_SIZE;  // 1..WP_BVH_MAX_LEAF_SIZE
-  // SAH cost model (relative): one node visit vs one triangle test.
+  // Width 2: 1..WP_BVH_MAX_LEAF_SIZE triangles; width 8: 1..4 * WP_BVH8_MAX_LEAF_BLOCKS.
+  int max_leaf_size = WP_BVH_MAX_LEAF_SIZE;
+  // SAH cost model (relative), in the unit of each layout's work: one node visit (binary or
+  // 8-wide) vs one triangle test (width 2) or one 4-triangle block test (width 8); Embree's SAH
+  // then counts a width-8 leaf as ceil(n / 4) blocks. Why 1 and 1 suit both: embree_tree.cpp.
   float traversal_cost = 1.0f;
   float intersection_cost = 1.0f;
 };
@@ -35,16 +40,25 @@ struct BuildInput {
 
 struct BuildStats {
   double build_seconds = 0;  // rtcBuildBVH plus flattening, wall clock
-  double sah_cost = 0;       // SAH cost of the flattened tree, relative to the root's surface area
-  std::size_t inner_nodes = 0;
-  std::size_t leaves = 0;
-  std::size_t triangle_refs = 0;  // > triangle_count only with spatial splits
-  int max_depth = 0;              // root = depth 1
+  // SAH cost of the flattened tree, with A(x) the surface area of x's box (as stored in its
+  // parent; the scene bounds for the root):
+  //   sum over inner nodes n of traversal_cost * A(n) / A(root)
+  //   + sum over leaves l of intersection_cost * work(l) * A(l) / A(root),
+  // work(l) = its triangle count (width 2) or its block count ceil(count / 4) (width 8).
+  double sah_cost = 0;
+  std::size_t inner_nodes = 0;    // nodes in the layout
+  std::size_t leaves = 0;         // leaf child references (width 8: ranges of blocks)
+  std::size_t triangle_refs = 0;  // > triangle_count only with spatial splits (no unused lanes)
+  int max_depth = 0;              // of inner nodes, root = depth 1
 };
 
+// One layout is filled, the other's arrays stay empty.
 struct Bvh {
-  std::vector<dev::BvhNode> nodes;       // depth-first, node 0 is the root
-  std::vector<dev::IsectTri> triangles;  // reordered triangle references
+  int width = 2;
+  std::vector<dev::BvhNode> nodes;       // width 2: depth-first, node 0 is the root
+  std::vector<dev::IsectTri> triangles;  // width 2: reordered triangle references
+  std::vector<dev::BvhNode8> nodes8;     // width 8: depth-first preorder, node 0 is the root
+  std::vector<dev::TriBlock4> blocks;    // width 8: each leaf's triangles, 4 per block
   glm::vec3 lo{0.0f}, hi{0.0f};          // scene bounds
   BuildStats stats;
 };
@@ -52,12 +66,14 @@ struct Bvh {
 // Builds the BVH. Throws wp::Error on failure (e.g. no triangles, Embree error).
 Bvh build(const BuildInput& input, const BuildOptions& options = {});
 
-// CPU reference traversal of the flattened layout, with the same triangle test as the kernels.
+// CPU reference traversal of the flattened layout (either width, by bvh.width), with the same
+// arithmetic as the kernels: the specification they copy (arithmetic: traverse_common.h; order:
+// bvh_traverse.cpp for width 2, bvh_traverse_wide.cpp for width 8).
 struct Ray {
   glm::vec3 o;
   glm::vec3 d;
   float tmin = 0.0f;
-  float tmax = 1e30f;
+  float tmax = 1e30f;  // may be +INFINITY
 };
 struct Hit {
   bool hit = false;
@@ -67,15 +83,20 @@ struct Hit {
 Hit intersect_closest(const Bvh& bvh, const Ray& ray);
 bool occluded(const Bvh& bvh, const Ray& ray);
 
-// The traversal's triangle test (Moller-Trumbore, bvh_traverse.cpp) on one stored triangle alone:
+// The traversal's triangle test (Moller-Trumbore, traverse_common.h) on one stored triangle alone:
 // returns whether ray.tmin < t < tmax, and then fills `hit`. For tests that judge near-ties.
 bool intersect_triangle(const dev::IsectTri& tri, const Ray& ray, float tmax, Hit& hit);
 
 // Structural checks; returns an empty string when all hold, else a description of the first
-// violation. Checked: every child box lies inside its parent's; leaves are within
-// WP_BVH_MAX_LEAF_SIZE; depth <= WP_BVH_MAX_DEPTH; every scene triangle is referenced (exactly
-// once unless `spatial_splits`); without spatial splits, each referenced triangle lies inside its
-// leaf's box.
+// violation. Checked for both widths: every child box lies inside its parent's; no node is reached
+// twice and every node is reached; depth-first order (width 2: a node's first inner child follows
+// it; width 8: the exact preorder, children in slot order); inner-node depth <=
+// WP_BVH_MAX_DEPTH / WP_BVH8_MAX_DEPTH; every scene triangle is referenced (exactly once unless
+// `spatial_splits`); without spatial splits, each referenced triangle lies inside its leaf's box.
+// Width 2: leaves of 1..WP_BVH_MAX_LEAF_SIZE triangles. Width 8: used slots first, unused slots
+// (child 0, boxes +INFINITY) last; leaves of 1..WP_BVH8_MAX_LEAF_BLOCKS blocks that no two leaves
+// share, with the unused lanes (all-zero v0 and edges, prim 0xffffffff, flags 0) only at the end
+// of a leaf's last block, which has at least one used lane.
 std::string check_invariants(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits);
 
 }  // namespace wp::bvh

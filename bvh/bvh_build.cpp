@@ -1,5 +1,5 @@
-// build(): Embree's binary tree (embree_tree.cpp) flattened into the device layout of
-// kernels/shared/bvh_layout.h, with its statistics.
+// build(): Embree's tree (embree_tree.cpp) flattened into the device layout of
+// kernels/shared/bvh_layout.h for options.width, with its statistics; the binary flattener.
 #include <algorithm>
 #include <chrono>
 #include <cstring>
@@ -37,18 +37,12 @@ void set_child(dev::BvhNode& node, int slot, const Box& b, std::int32_t link, st
   (slot == 0 ? node.link.z : node.link.w) = count;
 }
 
-// Depth-first preorder flattening of a binary tree, accumulating the SAH cost
-//   sah = sum over inner nodes n of  traversal_cost * A(n) / A(root)
-//       + sum over leaves l of       intersection_cost * count(l) * A(l) / A(root)
-// where A is the surface area of a node's box (the box stored for it in its parent; the scene
-// bounds for the root). A flat or point-like root (A(root) = 0) counts every ratio as 1.
+// Depth-first preorder flattening of a binary tree, accumulating the SAH cost of
+// BuildStats::sah_cost (work(l) = the leaf's triangle count).
 class Flattener {
  public:
   Flattener(const BuildInput& input, const BuildOptions& options, const Box& root, Bvh& out)
-      : input_(input), options_(options), out_(out) {
-    const double a = detail::surface_area(root);
-    inv_root_area_ = a > 0 ? 1.0 / a : 0.0;
-  }
+      : input_(input), options_(options), out_(out), area_ratio_(root) {}
 
   // Flattens the subtree of inner node `n`, whose own box is `box`; returns its node index.
   std::int32_t inner(const TreeInner& n, const Box& box, int depth) {
@@ -89,7 +83,7 @@ class Flattener {
   void account_inner(const Box& box, int depth) {
     stats().inner_nodes++;
     stats().max_depth = std::max(stats().max_depth, depth);
-    stats().sah_cost += double(options_.traversal_cost) * area_ratio(box);
+    stats().sah_cost += double(options_.traversal_cost) * area_ratio_(box);
   }
 
   // Appends the leaf's triangles; returns its child reference ~first.
@@ -100,47 +94,53 @@ class Flattener {
     for (unsigned i = 0; i < leaf.count; ++i) out_.triangles.push_back(isect_tri(leaf.prims[i]));
     stats().leaves++;
     stats().triangle_refs += leaf.count;
-    stats().sah_cost += double(options_.intersection_cost) * leaf.count * area_ratio(box);
+    stats().sah_cost += double(options_.intersection_cost) * leaf.count * area_ratio_(box);
     return ~static_cast<std::int32_t>(first);
   }
 
   dev::IsectTri isect_tri(std::uint32_t index) const {
-    const std::uint32_t* idx = input_.indices + 3 * static_cast<std::size_t>(index);
-    const glm::vec3 v0 = input_.positions[idx[0]];
-    const glm::vec3 e1 = input_.positions[idx[1]] - v0;
-    const glm::vec3 e2 = input_.positions[idx[2]] - v0;
-    const std::uint32_t flags = input_.triangle_flags ? input_.triangle_flags[index] : 0u;
-    return dev::IsectTri{dev::float4{v0.x, v0.y, v0.z, uint_bits_as_float(index)},
-                         dev::float4{e1.x, e1.y, e1.z, uint_bits_as_float(flags)},
-                         dev::float4{e2.x, e2.y, e2.z, 0.0f}};
+    const detail::StoredTriangle t = detail::stored_triangle(input_, index);
+    return dev::IsectTri{dev::float4{t.v0.x, t.v0.y, t.v0.z, uint_bits_as_float(index)},
+                         dev::float4{t.e1.x, t.e1.y, t.e1.z, uint_bits_as_float(t.flags)},
+                         dev::float4{t.e2.x, t.e2.y, t.e2.z, 0.0f}};
   }
 
-  double area_ratio(const Box& b) const {
-    return inv_root_area_ > 0 ? detail::surface_area(b) * inv_root_area_ : 1.0;
-  }
   BuildStats& stats() { return out_.stats; }
 
   const BuildInput& input_;
   const BuildOptions& options_;
   Bvh& out_;
-  double inv_root_area_ = 0;
+  const detail::AreaRatio area_ratio_;
 };
 
 }  // namespace
 
+namespace detail {
+
+void flatten_binary(const TreeNode& root, const Box& scene, const BuildInput& input,
+                    const BuildOptions& options, Bvh& out) {
+  out.triangles.reserve(input.triangle_count);
+  Flattener flattener(input, options, scene, out);
+  if (root.is_leaf)
+    flattener.single_leaf(static_cast<const TreeLeaf&>(root), scene);
+  else
+    flattener.inner(static_cast<const TreeInner&>(root), scene, 1);
+}
+
+}  // namespace detail
+
 Bvh build(const BuildInput& input, const BuildOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const detail::EmbreeTree tree = detail::build_embree_tree(input, options, 2);
+  const detail::EmbreeTree tree = detail::build_embree_tree(input, options);
 
   Bvh out;
+  out.width = options.width;
   out.lo = tree.scene_bounds.lo;
   out.hi = tree.scene_bounds.hi;
-  out.triangles.reserve(input.triangle_count);
-  Flattener flattener(input, options, tree.scene_bounds, out);
-  if (tree.root->is_leaf)
-    flattener.single_leaf(static_cast<const TreeLeaf&>(*tree.root), tree.scene_bounds);
+  if (options.width == WP_BVH8_WIDTH)
+    detail::flatten_wide(*tree.root, tree.scene_bounds, input, options, out);
   else
-    flattener.inner(static_cast<const TreeInner&>(*tree.root), tree.scene_bounds, 1);
+    detail::flatten_binary(*tree.root, tree.scene_bounds, input, options, out);
 
   out.stats.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,32 +1,23 @@
 // check_invariants(): structural checks of a flattened BVH (the contract is in bvh.h and
-// kernels/shared/bvh_layout.h). Walks the tree from node 0 and reports the first violation.
-#include <algorithm>
-#include <cmath>
+// kernels/shared/bvh_layout.h), the binary layout here, the wide one in bvh_check_wide.cpp. Walks
+// the tree from node 0 and reports the first violation.
 #include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "bvh.h"
+#include "check_common.h"
 
 namespace wp::bvh {
 namespace {
 
-struct ChildBox {
-  float lo[3], hi[3];
-};
+using detail::ChildBox;
 
 ChildBox child_box(const dev::BvhNode& n, int slot) {
   const dev::float4& xy = slot == 0 ? n.c0_xy : n.c1_xy;
   const float loz = slot == 0 ? n.c01_z.x : n.c01_z.z;
   const float hiz = slot == 0 ? n.c01_z.y : n.c01_z.w;
   return ChildBox{{xy.x, xy.z, loz}, {xy.y, xy.w, hiz}};
-}
-
-bool inside(const ChildBox& c, const ChildBox& p) {
-  for (int k = 0; k < 3; ++k)
-    if (!(c.lo[k] >= p.lo[k] && c.hi[k] <= p.hi[k] && c.lo[k] <= c.hi[k])) return false;
-  return true;
 }
 
 std::uint32_t bits(float f) {
@@ -38,20 +29,17 @@ std::uint32_t bits(float f) {
 class Checker {
  public:
   Checker(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits)
-      : bvh_(bvh), triangle_count_(triangle_count), splits_(spatial_splits) {
-    const float extent = std::max({std::fabs(bvh.lo.x), std::fabs(bvh.lo.y), std::fabs(bvh.lo.z),
-                                   std::fabs(bvh.hi.x), std::fabs(bvh.hi.y), std::fabs(bvh.hi.z)});
-    // v1 = v0 + e1 is rebuilt with a rounding error of a few ulps of the coordinates.
-    tolerance_ = 1e-6f * extent + 1e-30f;
-  }
+      : bvh_(bvh),
+        splits_(spatial_splits),
+        tolerance_(detail::fit_tolerance(bvh)),
+        refs_(triangle_count) {}
 
   std::string run() {
     if (bvh_.nodes.empty()) return "no nodes (node 0 must be the root)";
+    if (!bvh_.nodes8.empty() || !bvh_.blocks.empty()) return "width 2 with wide-layout arrays";
     visited_.assign(bvh_.nodes.size(), false);
     slot_owner_.assign(bvh_.triangles.size(), false);
-    refs_.assign(triangle_count_, 0);
-    const ChildBox scene{{bvh_.lo.x, bvh_.lo.y, bvh_.lo.z}, {bvh_.hi.x, bvh_.hi.y, bvh_.hi.z}};
-    std::vector<Pending> todo{{0, scene, 1}};
+    std::vector<Pending> todo{{0, detail::scene_box(bvh_), 1}};
     visited_[0] = true;
     while (!todo.empty() && error_.empty()) {
       const Pending p = todo.back();
@@ -81,7 +69,7 @@ class Checker {
     const std::int32_t count = slot == 0 ? n.link.z : n.link.w;
     const ChildBox box = child_box(n, slot);
     if (link < 0 && count == 0) return empty_child(p, slot, box);
-    if (!inside(box, p.box)) return fail(p.node, slot, "box not inside its parent's");
+    if (!detail::inside(box, p.box)) return fail(p.node, slot, "box not inside its parent's");
     if (link < 0) return leaf(p.node, slot, ~link, count, box);
     if (count != 0) return fail(p.node, slot, "inner child with a triangle count");
     if (static_cast<std::size_t>(link) >= bvh_.nodes.size())
@@ -115,62 +103,40 @@ class Checker {
       slot_owner_[i] = true;
       const dev::IsectTri& t = bvh_.triangles[i];
       const std::uint32_t index = bits(t.v0.w);
-      if (index >= triangle_count_) return fail(node, slot, "triangle index out of range");
+      if (!refs_.add(index)) return fail(node, slot, "triangle index out of range");
       if (bits(t.e2.w) != 0) return fail(node, slot, "e2.w not 0");
-      refs_[index]++;
       if (!triangle_fits(t, box))
         return fail(node, slot, "triangle " + std::to_string(index) + " outside its leaf box");
     }
   }
 
-  // Without spatial splits the whole triangle lies in the leaf box; with them its bounds must at
-  // least overlap the box (the box holds a clipped piece).
   bool triangle_fits(const dev::IsectTri& t, const ChildBox& box) const {
     const float v0[3] = {t.v0.x, t.v0.y, t.v0.z};
     const float e1[3] = {t.e1.x, t.e1.y, t.e1.z};
     const float e2[3] = {t.e2.x, t.e2.y, t.e2.z};
-    for (int k = 0; k < 3; ++k) {
-      const float lo = std::min({v0[k], v0[k] + e1[k], v0[k] + e2[k]});
-      const float hi = std::max({v0[k], v0[k] + e1[k], v0[k] + e2[k]});
-      const bool ok = splits_ ? hi >= box.lo[k] - tolerance_ && lo <= box.hi[k] + tolerance_
-                              : lo >= box.lo[k] - tolerance_ && hi <= box.hi[k] + tolerance_;
-      if (!ok) return false;
-    }
-    return true;
+    return detail::triangle_fits(v0, e1, e2, box, splits_, tolerance_);
   }
 
   void finish() {
-    const auto unvisited = std::find(visited_.begin(), visited_.end(), false);
-    if (unvisited != visited_.end()) {
-      error_ = "node " + std::to_string(unvisited - visited_.begin()) + " unreachable";
-      return;
-    }
-    const auto unused = std::find(slot_owner_.begin(), slot_owner_.end(), false);
-    if (unused != slot_owner_.end()) {
-      error_ = "triangle slot " + std::to_string(unused - slot_owner_.begin()) + " in no leaf";
-      return;
-    }
-    for (std::size_t i = 0; i < refs_.size(); ++i) {
-      if (refs_[i] == 0 || (!splits_ && refs_[i] != 1)) {
-        error_ =
-            "triangle " + std::to_string(i) + " referenced " + std::to_string(refs_[i]) + " times";
-        return;
-      }
-    }
+    error_ = detail::first_unset(visited_, "node", "unreachable");
+    if (error_.empty()) error_ = detail::first_unset(slot_owner_, "triangle slot", "in no leaf");
+    if (error_.empty()) error_ = refs_.check(splits_);
   }
 
   const Bvh& bvh_;
-  std::size_t triangle_count_;
   bool splits_;
-  float tolerance_ = 0;
+  float tolerance_;
+  detail::RefCounts refs_;
   std::vector<bool> visited_, slot_owner_;
-  std::vector<std::uint32_t> refs_;
   std::string error_;
 };
 
 }  // namespace
 
 std::string check_invariants(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits) {
+  if (bvh.width == WP_BVH8_WIDTH)
+    return detail::check_invariants_wide(bvh, triangle_count, spatial_splits);
+  if (bvh.width != 2) return "width " + std::to_string(bvh.width) + " is not 2 or 8";
   return Checker(bvh, triangle_count, spatial_splits).run();
 }
 

@@ -1,4 +1,5 @@
-/* Ray traversal of the flattened binary BVH (shared/bvh_layout.h): closest hit and any hit.
+/* Ray traversal of the flattened BVH (shared/bvh_layout.h): closest hit and any hit. The binary
+ * layout is here; with -D WP_BVH_WIDTH=8 the wide one (traverse8.h) replaces it.
  *
  * The arithmetic is exactly that of the CPU reference (bvh/bvh_traverse.cpp), which the tests
  * compare against Embree: slab test with clamped reciprocal directions, Moller-Trumbore written
@@ -100,6 +101,13 @@ inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref, int co
   return found;
 }
 
+#ifndef WP_BVH_WIDTH
+#define WP_BVH_WIDTH 2
+#endif
+
+#if WP_BVH_WIDTH == 8
+#include "traverse8.h"
+#else
 /* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
  * hit; the hit record holds the closest one found. */
 inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
@@ -141,5 +149,7 @@ inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, Tra
   }
   return found;
 }
+
+#endif /* WP_BVH_WIDTH */
 
 #endif /* WP_TRAVERSE_H */

@@ -40,6 +40,38 @@ typedef struct BvhNode {
   int4 link;    /* x, y: child references; z, w: leaf triangle counts (0 for inner children) */
 } BvhNode;
 
+/* The wide layout, for CPU devices (-D WP_BVH_WIDTH=8): 8 children per node, their boxes stored
+ * as structure-of-arrays so one node is tested with float8 operations, and leaves made of blocks
+ * of 4 triangles tested together with float4 operations. Nodes are depth-first, node 0 the root.
+ * child.s[i]:
+ *   >= 0 : index of an inner node;
+ *   <  0 : a leaf; with c = ~child.s[i], its blocks are [c >> 2, (c >> 2) + (c & 3) + 1) in the
+ *          block array (1 to WP_BVH8_MAX_LEAF_BLOCKS blocks);
+ * an unused slot has child 0 (node 0 is the root, never a child: traversal skips it) and the box
+ * lo = hi = +INFINITY, which keeps out every ray with a finite tmax (a ray with tmax = INFINITY
+ * and no negative direction component does enter it, with tnear = tfar = INFINITY). */
+#define WP_BVH8_WIDTH 8
+#define WP_BVH8_MAX_LEAF_BLOCKS 4
+/* Embree's maxDepth for the wide tree; the traversal stack holds at most 7 entries per level. */
+#define WP_BVH8_MAX_DEPTH 24
+#define WP_BVH8_STACK_SIZE (7 * WP_BVH8_MAX_DEPTH + 1)
+
+typedef struct BvhNode8 {
+  float8 lo_x, hi_x, lo_y, hi_y, lo_z, hi_z; /* child boxes, lane i = child i */
+  int8 child;
+} BvhNode8;
+
+/* Four triangles, lane by lane: v0, e1 = v1 - v0, e2 = v2 - v0 (as in IsectTri), the scene
+ * triangle index and WP_TRI_* flags. Unused lanes have zero edges (det = 0: never hit) and
+ * prim 0xffffffff. */
+typedef struct TriBlock4 {
+  float4 v0x, v0y, v0z;
+  float4 e1x, e1y, e1z;
+  float4 e2x, e2y, e2z;
+  uint4 prim;
+  uint4 flags;
+} TriBlock4;
+
 typedef struct IsectTri {
   float4 v0; /* xyz: vertex 0; w: scene triangle index (bits of a uint) */
   float4 e1; /* xyz: v1 - v0;  w: WP_TRI_* flags (bits of a uint) */

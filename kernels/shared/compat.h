@@ -37,6 +37,12 @@ struct alignas(16) int4 {
 struct alignas(16) uint4 {
   std::uint32_t x, y, z, w;
 };
+struct alignas(32) float8 {
+  float s[8];
+};
+struct alignas(32) int8 {
+  std::int32_t s[8];
+};
 WP_DEV_END
 
 #endif

@@ -1,0 +1,142 @@
+/* Ray traversal of the wide BVH (BvhNode8 / TriBlock4, shared/bvh_layout.h): closest hit and any
+ * hit, for CPU devices, where one node's 8 boxes are tested with float8 operations and 4 triangles
+ * with float4 operations (PoCL maps them to AVX/SSE lanes of one work-item).
+ *
+ * The order and arithmetic are those of the CPU reference (bvh/, width 8): all 8 boxes tested
+ * against the current closest t; then in lane order, leaves intersected at once, inner children
+ * collected and pushed nearest-on-top; the next node popped; an entry farther than the closest hit
+ * skipped. Included by traverse.h, which provides TraceRay, TraceHit and the alpha hook.
+ */
+#ifndef WP_TRAVERSE8_H
+#define WP_TRAVERSE8_H
+
+/* Moller-Trumbore on the 4 lanes of a block; updates *hit with the closest lane that is closer. */
+inline bool block_test(const SceneView* scene, const TraceRay* r, __global const TriBlock4* b,
+                       TraceHit* hit) {
+  const float4 e1x = b->e1x, e1y = b->e1y, e1z = b->e1z;
+  const float4 e2x = b->e2x, e2y = b->e2y, e2z = b->e2z;
+  const float4 px = r->dy * e2z - r->dz * e2y;
+  const float4 py = r->dz * e2x - r->dx * e2z;
+  const float4 pz = r->dx * e2y - r->dy * e2x;
+  const float4 det = e1x * px + e1y * py + e1z * pz;
+  const float4 inv = 1.0f / det;
+  const float4 sx = r->ox - b->v0x, sy = r->oy - b->v0y, sz = r->oz - b->v0z;
+  const float4 u = (sx * px + sy * py + sz * pz) * inv;
+  const float4 qx = sy * e1z - sz * e1y;
+  const float4 qy = sz * e1x - sx * e1z;
+  const float4 qz = sx * e1y - sy * e1x;
+  const float4 v = (r->dx * qx + r->dy * qy + r->dz * qz) * inv;
+  const float4 t = (e2x * qx + e2y * qy + e2z * qz) * inv;
+  const uint4 flags = b->flags;
+  const int4 cull = ((flags & WP_TRI_CULL_BACKFACE) != 0) & (det < 0.0f);
+  int4 ok = (det != 0.0f) & ~cull & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) & (u + v <= 1.0f) &
+            (t > r->tmin);
+  if (!any(ok)) return false;
+  /* Lanes in order, strictly closer replaces: the reference's rule. */
+  float tl[4], ul[4], vl[4];
+  int okl[4];
+  vstore4(t, 0, tl);
+  vstore4(u, 0, ul);
+  vstore4(v, 0, vl);
+  vstore4(ok, 0, okl);
+  const uint4 prim = b->prim;
+  uint pl[4], fl[4];
+  vstore4(prim, 0, pl);
+  vstore4(flags, 0, fl);
+  bool found = false;
+  for (int i = 0; i < 4; ++i) {
+    if (!okl[i] || !(tl[i] < hit->t)) continue;
+#if WP_FEATURE_ALPHA
+    if ((fl[i] & WP_TRI_ALPHA) && !alpha_passes(scene, pl[i], ul[i], vl[i], r->alpha_key)) continue;
+#else
+    (void)scene;
+    (void)fl;
+#endif
+    hit->t = tl[i], hit->u = ul[i], hit->v = vl[i], hit->tri = pl[i];
+    found = true;
+  }
+  return found;
+}
+
+inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref, TraceHit* hit,
+                       bool any_hit) {
+  const int c = ~ref;
+  __global const TriBlock4* b = (__global const TriBlock4*)scene->tris + (c >> 2);
+  const int blocks = (c & 3) + 1;
+  bool found = false;
+  for (int i = 0; i < blocks; ++i) {
+    if (block_test(scene, r, b + i, hit)) {
+      found = true;
+      if (any_hit) return true;
+    }
+  }
+  return found;
+}
+
+/* Closest hit (any_hit = false) or any hit (true) in (tmin, tmax). */
+inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
+                      bool any_hit) {
+  __global const BvhNode8* nodes = (__global const BvhNode8*)scene->nodes;
+  int stack_node[WP_BVH8_STACK_SIZE];
+  float stack_t[WP_BVH8_STACK_SIZE];
+  int sp = 0;
+  int node = 0;
+  bool found = false;
+  hit->t = tmax;
+  for (;;) {
+    __global const BvhNode8* n = nodes + node;
+    const float8 tx0 = (n->lo_x - r->ox) * r->ix, tx1 = (n->hi_x - r->ox) * r->ix;
+    const float8 ty0 = (n->lo_y - r->oy) * r->iy, ty1 = (n->hi_y - r->oy) * r->iy;
+    const float8 tz0 = (n->lo_z - r->oz) * r->iz, tz1 = (n->hi_z - r->oz) * r->iz;
+    const float8 tnear =
+        fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), (float8)(r->tmin)));
+    const float8 tfar =
+        fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), (float8)(hit->t)));
+    const int8 entered = tnear <= tfar;
+    if (any(entered)) {
+      int el[8], cl[8];
+      float tl[8];
+      vstore8(entered, 0, el);
+      vstore8(n->child, 0, cl);
+      vstore8(tnear, 0, tl);
+      /* Inner children, kept sorted with the nearest last (it goes on top of the stack). */
+      int inner_node[8];
+      float inner_t[8];
+      int count = 0;
+      for (int i = 0; i < 8; ++i) {
+        if (!el[i]) continue;
+        if (cl[i] < 0) {
+          if (leaf8_test(scene, r, cl[i], hit, any_hit)) {
+            found = true;
+            if (any_hit) return true;
+          }
+          continue;
+        }
+        if (cl[i] == 0) continue; /* an unused slot (node 0 is the root, nobody's child) */
+        /* Insertion: entries stay in decreasing tnear; a tie goes below the earlier lane. */
+        int j = count++;
+        while (j > 0 && inner_t[j - 1] <= tl[i]) {
+          inner_t[j] = inner_t[j - 1];
+          inner_node[j] = inner_node[j - 1];
+          --j;
+        }
+        inner_t[j] = tl[i];
+        inner_node[j] = cl[i];
+      }
+      for (int j = 0; j < count; ++j) {
+        stack_node[sp] = inner_node[j];
+        stack_t[sp] = inner_t[j];
+        ++sp;
+      }
+    }
+    /* Next: the top entry that can still hold something closer. */
+    for (;;) {
+      if (sp == 0) return found;
+      --sp;
+      if (!(stack_t[sp] > hit->t)) break;
+    }
+    node = stack_node[sp];
+  }
+}
+
+#endif /* WP_TRAVERSE8_H */
