@@ -1,0 +1,166 @@
+#include "host/bench/scene_bench.h"
+
+#include <algorithm>
+
+#include "host/device_scene.h"
+#include "host/gltf_loader.h"
+
+namespace wp::bench {
+
+namespace {
+
+// Where run_bounce begins a bounce: the surface and shadow queues and the next ray queue empty.
+void reset_bounce_counters(Wavefront::Snapshot& s, const dev::Launch& p) {
+  s.counters[WP_QUEUE_SURFACE] = 0;
+  s.counters[WP_QUEUE_SHADOW] = 0;
+  s.counters[p.queue_out] = 0;
+}
+
+bool in_bounce(Stage s) {
+  return s != Stage::kGenerateCameraRays && s != Stage::kAccumulate;
+}
+
+}  // namespace
+
+bvh::BuildInput build_input(const Scene& scene, std::vector<std::uint32_t>& flags) {
+  flags.assign(scene.triangle_count(), 0u);
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    const Material& m = scene.materials[scene.triangle_material[i]];
+    const bool cull = !m.double_sided && !(m.transmission > 0.0f && m.thickness > 0.0f);
+    flags[i] = (cull ? WP_TRI_CULL_BACKFACE : 0u) |
+               (m.alpha_mode != AlphaMode::kOpaque ? WP_TRI_ALPHA : 0u);
+  }
+  bvh::BuildInput in;
+  in.positions = scene.positions.data();
+  in.indices = scene.indices.data();
+  in.triangle_count = scene.triangle_count();
+  in.triangle_flags = flags.data();
+  return in;
+}
+
+SceneBench::SceneBench(const SceneSpec& spec)
+    : spec_(spec), scene_(load_gltf(spec.path)), bvh_input_(build_input(scene_, tri_flags_)) {
+  bvh_ = bvh::build(bvh_input_);
+  const RenderSettings s = bench_settings(false);
+  const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
+  wave_paths_ = static_cast<std::uint32_t>(std::min(pixels, std::size_t(1) << 20));
+}
+
+Wavefront& SceneBench::stages() {
+  if (!stages_) {
+    stages_ = std::make_unique<Wavefront>(*env().runtime, scene_, bvh_, bench_settings(false));
+    wave_paths_ = static_cast<std::uint32_t>(stages_->wave_size());
+    capture();
+  }
+  return *stages_;
+}
+
+void SceneBench::capture() {
+  Wavefront& wf = *stages_;
+  dev::Launch p = wf.start_wave(0, 0, wave_paths_);
+  std::uint32_t rays = wave_paths_;
+  bounces_.assign(kBounces, {});
+  for (int b = 0; b < kBounces; ++b) {
+    BounceCapture& c = bounces_[b];
+    c.start = wf.snapshot();
+    reset_bounce_counters(c.start, p);
+    c.params = p;
+    c.rays = rays;
+    if (rays == 0) continue;
+    rays = wf.run_bounce(p, rays);
+    c.surfaces = wf.counter(WP_QUEUE_SURFACE);
+    c.shadows = wf.counter(WP_QUEUE_SHADOW);
+  }
+}
+
+const BounceCapture& SceneBench::bounce(int b) {
+  stages();
+  return bounces_.at(static_cast<std::size_t>(b));
+}
+
+StageJob SceneBench::stage_job(Stage stage, int b) {
+  Wavefront& wf = stages();
+  if (!in_bounce(stage)) b = 0;
+  const BounceCapture& c = bounce(b);
+  StageJob job;
+  job.input = &input_;
+  if (stage == Stage::kGenerateCameraRays) {
+    job.params = wf.launch_params(0, 0, wave_paths_);
+    job.params.queue_out = WP_QUEUE_RAY_A;
+    job.launch_items = job.items = wave_paths_;
+  } else if (stage == Stage::kAccumulate) {
+    job.params = wf.launch_params(0, 0, wave_paths_);
+    job.launch_items = job.items = wave_paths_;
+  } else {
+    job.params = c.params;
+    job.launch_items = c.rays;
+    job.items = stage <= Stage::kShadeSurface  ? c.rays
+                : stage == Stage::kTraceShadow ? c.shadows
+                                               : c.surfaces;
+  }
+  if (input_bounce_ == b && input_stage_ == stage) return job;
+
+  input_ = {};  // release the previous input before making the next
+  wf.restore(c.start);
+  if (stage == Stage::kAccumulate) {
+    // The wave's remaining bounces, as the renderer runs them before accumulating.
+    dev::Launch p = c.params;
+    for (std::uint32_t rays = c.rays; rays > 0;) rays = wf.run_bounce(p, rays);
+  } else if (in_bounce(stage)) {
+    for (int s = static_cast<int>(Stage::kIntersectClosest); s < static_cast<int>(stage); ++s)
+      wf.launch_stage(static_cast<Stage>(s), c.rays, c.params);
+  }
+  wf.finish();
+  input_ = wf.snapshot();
+  input_stage_ = stage;
+  input_bounce_ = b;
+  return job;
+}
+
+Wavefront& SceneBench::render_wavefront() {
+  if (!render_) {
+    render_ = std::make_unique<Wavefront>(*env().runtime, scene_, bvh_, bench_settings(true));
+    render_->render_pass(next_sample());  // first-touch costs stay out of the figures
+  }
+  return *render_;
+}
+
+std::size_t SceneBench::device_memory_bytes() {
+  if (!device_bytes_) {
+    // The Wavefront does not report its buffers; their sizes follow from public pieces, the
+    // scene buffer from packing the scene again exactly as the Wavefront does.
+    Wavefront& wf = render_wavefront();
+    SceneExtras extras;
+    extras.lights = &wf.lights();
+    const std::size_t scene_bytes = pack_scene(scene_, bvh_, extras).bytes.size();
+    const RenderSettings s = bench_settings(true);
+    const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
+    device_bytes_ = scene_bytes + wf.path_state().bytes +
+                    WP_QUEUE_COUNT * wf.wave_size() * sizeof(dev::uint) +
+                    WP_COUNTER_COUNT * sizeof(dev::uint) + 2 * pixels * sizeof(dev::float4);
+  }
+  return *device_bytes_;
+}
+
+const EmbreeRef& SceneBench::embree() {
+  if (!embree_) embree_ = std::make_unique<EmbreeRef>(scene_);
+  return *embree_;
+}
+
+namespace {
+std::unique_ptr<SceneBench> current;
+}  // namespace
+
+SceneBench& scene_bench(const SceneSpec& spec) {
+  if (!current || current->spec().path != spec.path || current->spec().name != spec.name) {
+    current.reset();  // the previous scene's device buffers go before the next one's come
+    current = std::make_unique<SceneBench>(spec);
+  }
+  return *current;
+}
+
+void release_scene_bench() {
+  current.reset();
+}
+
+}  // namespace wp::bench
