@@ -36,7 +36,7 @@ dev::Material device_material(const Material& m) {
   d.params = {m.metallic, m.roughness, m.ior, m.transmission};
   d.volume =
       f4(m.attenuation_color, m.attenuation_distance > 0.0f ? m.attenuation_distance : INFINITY);
-  d.extra = {m.normal_scale, m.thickness, 0.0f, 0.0f};
+  d.extra = {m.normal_scale, m.thickness, m.specular, 0.0f};
   dev::uint flags = 0;
   if (m.double_sided) flags |= WP_MAT_DOUBLE_SIDED;
   if (m.alpha_mode == AlphaMode::kMask) flags |= WP_MAT_ALPHA_MASK;
@@ -137,8 +137,9 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
   d.background = f4(x.background);
   const float rotation = x.env_rotation_degrees * 3.14159265358979f / 180.0f;
   d.env_params = {x.env_intensity, std::cos(rotation), std::sin(rotation), 0.0f};
-  d.bvh_nodes = append(p.bytes, bvh.nodes);
-  d.isect_tris = append(p.bytes, bvh.triangles);
+  // The layout the program was built for (WP_BVH_WIDTH): the same two offsets either way.
+  d.bvh_nodes = bvh.width == 8 ? append(p.bytes, bvh.nodes8) : append(p.bytes, bvh.nodes);
+  d.isect_tris = bvh.width == 8 ? append(p.bytes, bvh.blocks) : append(p.bytes, bvh.triangles);
   d.tri_vertices = append(p.bytes, tri_vertices);
   d.positions = append(p.bytes, positions);
   d.normals = append(p.bytes, normals);

@@ -27,17 +27,25 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
-void write_exr(const std::string& path, const ImageRgb& img,
-               const std::map<std::string, std::string>& attributes) {
-  Imf::Header header(img.width, img.height);
-  for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
-  for (const auto& [key, value] : attributes) header.insert(key, Imf::StringAttribute(value));
-  Imf::FrameBuffer fb;
+// Adds img's R, G, B as channels `prefix`R/G/B to the header and the frame buffer.
+void add_rgb(Imf::Header& header, Imf::FrameBuffer& fb, const ImageRgb& img,
+             const std::string& prefix) {
   const std::size_t xs = 3 * sizeof(float), ys = xs * static_cast<std::size_t>(img.width);
   char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgb.data()));
-  fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-  fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-  fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    header.channels().insert(prefix + names[c], Imf::Channel(Imf::FLOAT));
+    fb.insert(prefix + names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+  }
+}
+
+void write_exr(const std::string& path, const ImageRgb& img,
+               const std::map<std::string, std::string>& attributes, const ImageRgb* variance) {
+  Imf::Header header(img.width, img.height);
+  for (const auto& [key, value] : attributes) header.insert(key, Imf::StringAttribute(value));
+  Imf::FrameBuffer fb;
+  add_rgb(header, fb, img, "");
+  if (variance) add_rgb(header, fb, *variance, "variance.");
   Imf::OutputFile file(path.c_str(), header);
   file.setFrameBuffer(fb);
   file.writePixels(img.height);
@@ -56,6 +64,23 @@ void write_png(const std::string& path, const ImageRgb& img, const PngOptions& p
   for (std::size_t i = 0; i < img.rgb.size(); ++i) bytes[i] = png_encode(img.rgb[i], png);
   if (!stbi_write_png(path.c_str(), img.width, img.height, 3, bytes.data(), img.width * 3))
     throw Error("cannot write " + path);
+}
+
+// Portable FloatMap: "PF", size, -1 (little-endian), then float RGB rows from the bottom up.
+void write_pfm(const std::string& path, const ImageRgb& img) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw Error("cannot write " + path);
+  std::fprintf(f, "PF\n%d %d\n-1.0\n", img.width, img.height);
+  bool ok = true;
+  for (int y = img.height - 1; y >= 0; --y)
+    ok &= std::fwrite(img.rgb.data() + 3 * std::size_t(y) * std::size_t(img.width), sizeof(float),
+                      3 * std::size_t(img.width), f) == 3 * std::size_t(img.width);
+  ok &= std::fclose(f) == 0;
+  if (!ok) throw Error("cannot write " + path);
+}
+
+std::string variance_path(const std::string& pfm) {
+  return pfm.substr(0, pfm.size() - 4) + ".variance.pfm";
 }
 
 std::string temporary_name(const std::string& path) {
@@ -78,37 +103,51 @@ unsigned char png_encode(float linear, const PngOptions& png) {
 }
 
 void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
-                  const std::map<std::string, std::string>& exr_attributes, const PngOptions& png) {
+                  const std::map<std::string, std::string>& exr_attributes, const PngOptions& png,
+                  const ImageRgb* variance) {
+  std::vector<std::string> all = paths;
   for (const auto& path : paths) {
     const std::string ext = extension_of(path);
-    if (ext != ".exr" && ext != ".png")
-      throw Error(path + ": unsupported output format (use .exr or .png)");
+    if (ext != ".exr" && ext != ".png" && ext != ".pfm")
+      throw Error(path + ": unsupported output format (use .exr, .png or .pfm)");
+    if (ext == ".pfm" && variance) all.push_back(variance_path(path));
   }
   std::vector<std::string> temps;
   const auto remove_temps = [&] {
     for (const auto& t : temps) std::remove(t.c_str());
   };
   try {
-    for (const auto& path : paths) {
+    for (const auto& path : all) {
       temps.push_back(temporary_name(path));
-      if (extension_of(path) == ".exr")
-        write_exr(temps.back(), image, exr_attributes);
-      else
+      const std::string ext = extension_of(path);
+      if (ext == ".exr")
+        write_exr(temps.back(), image, exr_attributes, variance);
+      else if (ext == ".png")
         write_png(temps.back(), image, png);
+      else if (variance && path.size() > 13 &&
+               path.compare(path.size() - 13, 13, ".variance.pfm") == 0 &&
+               std::find(paths.begin(), paths.end(), path) == paths.end())
+        write_pfm(temps.back(), *variance);
+      else
+        write_pfm(temps.back(), image);
     }
-    for (std::size_t i = 0; i < paths.size(); ++i) std::filesystem::rename(temps[i], paths[i]);
+    for (std::size_t i = 0; i < all.size(); ++i) std::filesystem::rename(temps[i], all[i]);
   } catch (const Error& e) {
     remove_temps();
     throw;
   } catch (const std::exception& e) {
     remove_temps();
-    throw Error("cannot write " + paths[temps.empty() ? 0 : temps.size() - 1] + ": " + e.what());
+    throw Error("cannot write " + all[temps.empty() ? 0 : temps.size() - 1] + ": " + e.what());
   }
 }
 
-ImageRgb read_exr(const std::string& path) {
+ImageRgb read_exr(const std::string& path, const std::string& layer) {
+  const std::string prefix = layer.empty() ? "" : layer + ".";
   try {
     Imf::InputFile file(path.c_str());
+    for (const char* c : {"R", "G", "B"})
+      if (!file.header().channels().findChannel(prefix + c))
+        throw Error("cannot read " + path + ": no channel " + prefix + c);
     const Imath::Box2i dw = file.header().dataWindow();
     ImageRgb img;
     img.width = dw.max.x - dw.min.x + 1;
@@ -118,12 +157,14 @@ ImageRgb read_exr(const std::string& path) {
     char* base = reinterpret_cast<char*>(img.rgb.data()) - dw.min.x * std::ptrdiff_t(xs) -
                  dw.min.y * std::ptrdiff_t(ys);
     Imf::FrameBuffer fb;
-    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    fb.insert(prefix + "R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    fb.insert(prefix + "G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+    fb.insert(prefix + "B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
     return img;
+  } catch (const Error&) {
+    throw;
   } catch (const std::exception& e) {
     throw Error("cannot read " + path + ": " + e.what());
   }

@@ -1,7 +1,8 @@
-// Image output: linear float OpenEXR with the render settings as header attributes, and an 8-bit
-// sRGB PNG preview. Writes are atomic: each file is written beside its destination under a
-// temporary name and renamed into place only when every file of the set is complete, so a failed
-// run leaves no partial file and overwrites nothing.
+// Image output: linear float OpenEXR with the render settings as header attributes, an 8-bit
+// sRGB PNG preview, and linear float PFM (Portable FloatMap, simple to read from any language).
+// Writes are atomic: each file is written beside its destination under a temporary name and renamed
+// into place only when every file of the set is complete, so a failed run leaves no partial file
+// and overwrites nothing.
 #pragma once
 
 #include <map>
@@ -24,12 +25,15 @@ struct PngOptions {
 
 // Writes each of `paths` (by extension: .exr or .png) atomically as a set. Throws wp::Error naming
 // the file on failure (an unknown extension, an unwritable folder), after removing what it wrote.
+// With `variance`, EXR files also get the layer "variance" (channels variance.R/G/B): the
+// variance of each pixel's estimate; a PFM file x.pfm gets a companion x.variance.pfm.
 void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
                   const std::map<std::string, std::string>& exr_attributes,
-                  const PngOptions& png = {});
+                  const PngOptions& png = {}, const ImageRgb* variance = nullptr);
 
-// Reads an OpenEXR file's R, G, B channels as linear float. Throws wp::Error on failure.
-ImageRgb read_exr(const std::string& path);
+// Reads an OpenEXR file's R, G, B channels (of `layer`, e.g. "variance", when given) as linear
+// float. Throws wp::Error on failure, a missing layer included.
+ImageRgb read_exr(const std::string& path, const std::string& layer = "");
 // Reads the string attributes of an OpenEXR header.
 std::map<std::string, std::string> read_exr_attributes(const std::string& path);
 

@@ -4,6 +4,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -12,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "host/cl_runtime.h"
+#include "host/environment.h"
 #include "host/error.h"
 #include "host/gltf_loader.h"
 #include "host/render.h"
@@ -24,6 +27,12 @@ struct CliOptions {
   std::vector<std::string> outputs;
   std::string device;
   std::vector<float> env_color{0.0f, 0.0f, 0.0f};
+  std::string env;
+  std::string strategy = "mis";
+  std::string heuristic = "power";
+  std::string light_select = "power";
+  bool no_rr = false;
+  bool variance = false;
   std::string features = "scene";
   std::string tonemap = "aces";
   float exposure = 0.0f;
@@ -52,8 +61,8 @@ void check_outputs(const std::vector<std::string>& outputs) {
     const std::filesystem::path p(o);
     std::string ext = p.extension().string();
     for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".exr" && ext != ".png")
-      throw wp::Error(o + ": unsupported output format (use .exr or .png)");
+    if (ext != ".exr" && ext != ".png" && ext != ".pfm")
+      throw wp::Error(o + ": unsupported output format (use .exr, .png or .pfm)");
     const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
     if (!std::filesystem::is_directory(dir))
       throw wp::Error(o + ": folder " + dir.string() + " does not exist");
@@ -81,7 +90,17 @@ int render_command(CliOptions& cli, wp::RenderSettings& settings) {
   check_outputs(cli.outputs);
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
+  settings.strategy = cli.strategy == "nee"    ? wp::Strategy::kNee
+                      : cli.strategy == "bsdf" ? wp::Strategy::kBsdf
+                                               : wp::Strategy::kMis;
+  settings.mis_heuristic =
+      cli.heuristic == "balance" ? wp::MisHeuristic::kBalance : wp::MisHeuristic::kPower;
+  settings.light_select =
+      cli.light_select == "uniform" ? wp::LightSelect::kUniform : wp::LightSelect::kPower;
+  if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);
+  if (!cli.env.empty())
+    settings.environment = std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env));
 
   const auto start = std::chrono::steady_clock::now();
   const wp::Scene scene = wp::load_gltf(cli.scene);
@@ -100,7 +119,8 @@ int render_command(CliOptions& cli, wp::RenderSettings& settings) {
   png.exposure = cli.exposure;
   png.tonemap = cli.tonemap == "clamp" ? wp::Tonemap::kClamp : wp::Tonemap::kAces;
   wp::write_images(cli.outputs, result.image,
-                   wp::exr_attributes(cli.scene, settings, result.report), png);
+                   wp::exr_attributes(cli.scene, settings, result.report), png,
+                   cli.variance ? &result.variance : nullptr);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (result.report.nonfinite_samples > 0)
@@ -134,7 +154,8 @@ int main(int argc, char** argv) {
   render->add_option("scene", cli.scene, "glTF 2.0 file (.gltf or .glb)")->required();
   render->add_option("-o,--output", cli.outputs,
                      "Output file(s): .exr = linear float RGB with the settings in its header, "
-                     ".png = 8-bit sRGB preview [default: render.exr render.png]");
+                     ".png = 8-bit sRGB preview, .pfm = linear float RGB (Portable FloatMap) "
+                     "[default: render.exr render.png]");
   render->add_option("--width", settings.width, "Image width in pixels")->capture_default_str();
   render->add_option("--height", settings.height, "Image height in pixels")->capture_default_str();
   render->add_option("--spp", settings.spp, "Samples per pixel")->capture_default_str();
@@ -145,12 +166,36 @@ int main(int argc, char** argv) {
                    "Constant background radiance R,G,B (linear) [default: 0,0,0]")
       ->delimiter(',')
       ->expected(3);
+  render->add_option("--env", cli.env,
+                     "Environment map: equirectangular .hdr or .exr, linear radiance; the centre "
+                     "of the map is seen looking down -Z, +Y is up");
+  render->add_option("--env-intensity", settings.env_intensity, "Scale of the environment map")
+      ->capture_default_str();
+  render
+      ->add_option("--env-rotation", settings.env_rotation,
+                   "Rotation of the environment map about +Y, degrees")
+      ->capture_default_str();
+  render
+      ->add_option("--strategy", cli.strategy,
+                   "Direct light: mis (NEE and BSDF sampling, MIS-weighted), nee (light "
+                   "sampling only), bsdf (BSDF sampling only; punctual lights then add nothing)")
+      ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
+      ->capture_default_str();
+  render->add_option("--mis-heuristic", cli.heuristic, "MIS weights: power (beta 2) or balance")
+      ->check(CLI::IsMember({"power", "balance"}))
+      ->capture_default_str();
+  render
+      ->add_option("--light-select", cli.light_select,
+                   "How NEE picks a light: power (proportional to estimated power) or uniform")
+      ->check(CLI::IsMember({"power", "uniform"}))
+      ->capture_default_str();
   render->add_option("--max-depth", settings.max_depth, "Most scattering events per path")
       ->capture_default_str();
   render
       ->add_option("--rr-depth", settings.rr_depth,
                    "Russian roulette after this many scattering events")
       ->capture_default_str();
+  render->add_flag("--no-rr", cli.no_rr, "No Russian roulette (paths end only at --max-depth)");
   render->add_option("--seed", settings.seed, "Random seed (same seed, same image)")
       ->capture_default_str();
   render->add_option("--device", cli.device,
@@ -168,7 +213,13 @@ int main(int argc, char** argv) {
   render->add_flag("--spatial-splits", cli.spatial_splits,
                    "Build the BVH with spatial splits (slower build, faster traversal)");
   render->add_option("--wave-size", settings.wave_size, "Path slots per wave [default: auto]");
+  render->add_option("--bvh-width", settings.bvh_width,
+                     "BVH layout: 2 (binary) or 8 (wide, float8 box tests) [default: 2 on GPUs, "
+                     "8 on CPUs]");
   render->add_option("--local-size", settings.local_size, "Work-group size [default: 64]");
+  render->add_flag("--variance", cli.variance,
+                   "Also write the variance of each pixel's estimate (sample variance / spp): the "
+                   "layer variance.R/G/B in EXR output, X.variance.pfm beside X.pfm");
   render->add_flag("--profile", settings.profile, "Time each kernel (adds stage times to --json)");
   render->add_flag("--json", cli.json,
                    "Print a JSON summary as the last line of stdout (spp, width, height, "

@@ -22,29 +22,46 @@ void validate(const RenderSettings& s) {
   check(s.spp >= 1, "--spp must be at least 1");
   check(s.max_depth >= 0 && s.max_depth <= 1024, "--max-depth must be between 0 and 1024");
   check(s.rr_depth >= 0, "--rr-depth must be at least 0");
+  check(s.bvh_width == 0 || s.bvh_width == 2 || s.bvh_width == 8, "--bvh-width must be 2 or 8");
+  check(std::isfinite(s.env_intensity) && s.env_intensity >= 0.0f,
+        "--env-intensity must be a finite, non-negative number");
+  check(std::isfinite(s.env_rotation), "--env-rotation must be a finite number");
   for (int i = 0; i < 3; ++i)
     check(std::isfinite(s.background[i]) && s.background[i] >= 0.0f,
           "--env-color must be three finite, non-negative numbers");
+}
+
+bvh::BuildInput bvh_input(const Scene& scene, std::vector<std::uint32_t>& flags) {
+  bvh::BuildInput input;
+  input.positions = scene.positions.data();
+  input.indices = scene.indices.data();
+  input.triangle_count = scene.triangle_count();
+  flags.assign(scene.triangle_count(), 0u);
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    const Material& m = scene.materials[scene.triangle_material[i]];
+    // Back faces of a volume are where rays leave it: never culled.
+    const bool cull = !m.double_sided && !(m.transmission > 0.0f && m.thickness > 0.0f);
+    flags[i] = (cull ? WP_TRI_CULL_BACKFACE : 0u) |
+               (m.alpha_mode != AlphaMode::kOpaque ? WP_TRI_ALPHA : 0u);
+  }
+  input.triangle_flags = flags.data();
+  return input;
+}
+
+int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
+  if (settings.bvh_width) return settings.bvh_width;
+  return device.gpu ? 2 : 8;
 }
 
 Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
                 const RenderOptions& options) {
   validate(settings);
   const auto start = std::chrono::steady_clock::now();
-  bvh::BuildInput input;
-  input.positions = scene.positions.data();
-  input.indices = scene.indices.data();
-  input.triangle_count = scene.triangle_count();
-  std::vector<std::uint32_t> flags(scene.triangle_count());
-  for (std::size_t i = 0; i < flags.size(); ++i) {
-    const Material& m = scene.materials[scene.triangle_material[i]];
-    flags[i] = (m.double_sided ? 0u : WP_TRI_CULL_BACKFACE) |
-               (m.alpha_mode != AlphaMode::kOpaque ? WP_TRI_ALPHA : 0u);
-  }
-  input.triangle_flags = flags.data();
-  const bvh::Bvh bvh = bvh::build(input, options.bvh);
+  std::vector<std::uint32_t> flags;
+  bvh::BuildOptions bvh_options = options.bvh;
+  bvh_options.width = bvh_width(runtime.device(), settings);
+  const bvh::Bvh bvh = bvh::build(bvh_input(scene, flags), bvh_options);
 
-  const double build_before = runtime.build_seconds();
   Wavefront wavefront(runtime, scene, bvh, settings);
 
   Rendered out;
@@ -54,7 +71,8 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.build_options = wavefront.build_options();
   r.triangles = scene.triangle_count();
   r.bvh = bvh.stats;
-  r.kernel_build_seconds = runtime.build_seconds() - build_before;
+  r.kernel_build_seconds = wavefront.build_seconds();
+  r.kernel_binary_bytes = wavefront.binary_bytes();
   r.setup_seconds = since(start);
   r.wave_size = wavefront.wave_size();
   r.bytes_per_path = wavefront.path_state().bytes_per_path;
@@ -68,9 +86,9 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.render_seconds = since(passes_start);
   r.nonfinite_samples = wavefront.nonfinite_samples();
   r.stages = wavefront.stage_times();
-  out.image.width = settings.width;
-  out.image.height = settings.height;
-  out.image.rgb = wavefront.image(static_cast<std::uint32_t>(settings.spp));
+  FilmImages film = wavefront.image(static_cast<std::uint32_t>(settings.spp));
+  out.image = {settings.width, settings.height, std::move(film.mean)};
+  out.variance = {settings.width, settings.height, std::move(film.variance)};
   return out;
 }
 

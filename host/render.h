@@ -21,9 +21,10 @@ struct RenderReport {
   std::size_t triangles = 0;
   bvh::BuildStats bvh;
   double kernel_build_seconds = 0;  // includes the OpenCL implementation's cache lookup
-  double setup_seconds = 0;         // BVH, upload, program: from scene to first pass
-  double render_seconds = 0;        // sample passes, wall clock
-  double first_pass_seconds = 0;    // from the call to the end of the first pass
+  std::size_t kernel_binary_bytes = 0;
+  double setup_seconds = 0;       // BVH, upload, program: from scene to first pass
+  double render_seconds = 0;      // sample passes, wall clock
+  double first_pass_seconds = 0;  // from the call to the end of the first pass
   std::uint64_t nonfinite_samples = 0;
   std::size_t wave_size = 0;
   std::size_t bytes_per_path = 0;
@@ -40,7 +41,8 @@ struct RenderOptions {
 };
 
 struct Rendered {
-  ImageRgb image;
+  ImageRgb image;     // the estimate of every pixel
+  ImageRgb variance;  // the variance of each pixel's estimate (sample variance / spp)
   RenderReport report;
 };
 
@@ -50,5 +52,13 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
 
 // Checks the ranges of user-facing settings; throws wp::Error naming the option.
 void validate(const RenderSettings& settings);
+
+// The BVH build input for `scene`: its triangles, and per triangle the WP_TRI_* flags its
+// material implies (back-face culling for single-sided materials, alpha testing), kept in `flags`.
+bvh::BuildInput bvh_input(const Scene& scene, std::vector<std::uint32_t>& flags);
+
+// The BVH layout for `device`: settings.bvh_width if set, else 2 (binary, both child boxes in the
+// parent) on GPUs and 8 (wide, float8 box tests) on CPUs.
+int bvh_width(const DeviceEntry& device, const RenderSettings& settings);
 
 }  // namespace wp

@@ -52,6 +52,14 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
           {"wavepath:camera", std::to_string(s.camera)},
           {"wavepath:background",
            num(s.background.x) + "," + num(s.background.y) + "," + num(s.background.z)},
+          {"wavepath:strategy", s.strategy == Strategy::kMis   ? "mis"
+                                : s.strategy == Strategy::kNee ? "nee"
+                                                               : "bsdf"},
+          {"wavepath:mis_heuristic", s.mis_heuristic == MisHeuristic::kPower ? "power" : "balance"},
+          {"wavepath:light_select", s.light_select == LightSelect::kPower ? "power" : "uniform"},
+          {"wavepath:environment", s.environment ? s.environment->source : std::string("constant")},
+          {"wavepath:env_intensity", num(s.env_intensity)},
+          {"wavepath:env_rotation", num(s.env_rotation)},
           {"wavepath:device", r.device},
           {"wavepath:features", r.features},
           {"wavepath:nonfinite_samples", std::to_string(r.nonfinite_samples)},
@@ -66,6 +74,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"samples_per_second\":" << num(r.samples_per_second(s))
     << ",\"device\":" << json_string(r.device) << ",\"triangles\":" << r.triangles
     << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)
+    << ",\"kernel_binary_bytes\":" << r.kernel_binary_bytes
     << ",\"bvh_build_seconds\":" << num(r.bvh.build_seconds)
     << ",\"bvh_sah_cost\":" << num(r.bvh.sah_cost) << ",\"setup_seconds\":" << num(r.setup_seconds)
     << ",\"first_pass_seconds\":" << num(r.first_pass_seconds)

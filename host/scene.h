@@ -57,6 +57,7 @@ struct Material {
   float ior = 1.5f;           // KHR_materials_ior
   float transmission = 0.0f;  // KHR_materials_transmission factor
   bool unlit = false;         // KHR_materials_unlit
+  float specular = 1.0f;      // KHR_materials_specular specularFactor (0: a pure Lambertian)
   // KHR_materials_volume: with thickness > 0 the surface bounds a volume (refraction bends rays,
   // the inside absorbs); without it a transmissive surface is thin-walled.
   float thickness = 0.0f;

@@ -1,6 +1,7 @@
 #include "host/wavefront.h"
 
 #include <algorithm>
+#include <chrono>
 
 #include "host/device_scene.h"
 #include "host/error.h"
@@ -13,8 +14,8 @@ namespace {
 
 // The one place where program build options are assembled: the scene's features and the
 // settings that are compile-time constants of the kernels.
-std::string program_options(const SceneFeatures& features, const RenderSettings& s) {
-  std::string o = "-cl-std=CL1.2";
+std::string program_options(const SceneFeatures& features, const RenderSettings& s, int bvh_width) {
+  std::string o = "-cl-std=CL1.2 -D WP_BVH_WIDTH=" + std::to_string(bvh_width);
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
   o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
@@ -52,7 +53,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   const EnvironmentMap* env = settings.environment.get();
   features_ =
       settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
-  options_ = program_options(features_, settings);
+  options_ = program_options(features_, settings, bvh.width);
   path_state_ = path_state_layout(wave_size_);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
@@ -74,13 +75,15 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     queue_slots_ =
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
     counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
-    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, pixels * sizeof(dev::float4));
+    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, 2 * pixels * sizeof(dev::float4));
     rt_.queue().enqueueFillBuffer(counters_, dev::uint(0), 0, WP_COUNTER_COUNT * sizeof(dev::uint));
-    rt_.queue().enqueueFillBuffer(film_, dev::float4{0, 0, 0, 0}, 0, pixels * sizeof(dev::float4));
+    rt_.queue().enqueueFillBuffer(film_, dev::float4{0, 0, 0, 0}, 0,
+                                  2 * pixels * sizeof(dev::float4));
   } catch (const cl::Error& e) {
     rethrow_cl(e, "allocating device memory on " + rt_.device().name);
   }
 
+  const auto build_start = std::chrono::steady_clock::now();
   program_ = rt_.build(program_source(), options_);
   for (int i = 0; i < kStageCount; ++i) {
     if (static_cast<Stage>(i) == Stage::kAccumulate)
@@ -88,10 +91,35 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     else
       stage_kernels_.emplace_back(program_, kStageNames[i]);
   }
+  prime_kernels();
+  try {
+    for (const auto size : program_.getInfo<CL_PROGRAM_BINARY_SIZES>()) binary_bytes_ += size;
+  } catch (const cl::Error&) {
+    binary_bytes_ = 0;  // not every implementation reports binaries
+  }
+  build_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 }
 
-void Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
-  if (items == 0) return;
+// Some implementations (PoCL) compile a kernel only at its first launch, for the work-group size
+// of that launch. One empty launch of each stage here makes that cost part of the build (where
+// kernel_build_seconds reports it) instead of the first sample pass.
+void Wavefront::prime_kernels() {
+  dev::Launch p = launch_params(0, 0, 0);  // no paths: every work-item returns at once
+  p.queue_in = WP_QUEUE_RAY_A;
+  p.queue_out = WP_QUEUE_RAY_B;
+  try {
+    for (int i = 0; i < kStageCount; ++i)
+      launch(static_cast<Stage>(i), static_cast<std::uint32_t>(local_size_), p);
+    rt_.queue().finish();
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "preparing the kernels on " + rt_.device().name);
+  }
+  pending_events_.clear();
+}
+
+cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
+  if (items == 0) return cl::Event();
   const std::size_t local = local_size_;
   const std::size_t global = local ? (items + local - 1) / local * local : items;
   const cl::EnqueueArgs args(rt_.queue(), cl::NDRange(global),
@@ -108,6 +136,7 @@ void Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& para
     rethrow_cl(e, std::string("launching ") + stage_name(stage));
   }
   if (settings_.profile) pending_events_.emplace_back(stage, event);
+  return event;
 }
 
 void Wavefront::reset_counters(std::uint32_t first, std::uint32_t count) {
@@ -149,26 +178,56 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
 
 // One wave of paths through all bounces: the algorithm, one named call per stage.
 void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count) {
+  dev::Launch p = start_wave(sample, first_pixel, count);
+  for (std::uint32_t rays = count; rays > 0;) rays = run_bounce(p, rays);
+  launch(Stage::kAccumulate, count, p);
+}
+
+dev::Launch Wavefront::start_wave(std::uint32_t sample, std::uint32_t first_pixel,
+                                  std::uint32_t count) {
   dev::Launch p = launch_params(sample, first_pixel, count);
   p.queue_out = WP_QUEUE_RAY_A;
   launch(Stage::kGenerateCameraRays, count, p);
-
-  std::uint32_t rays = count;
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
-  while (rays > 0) {
-    reset_counters(WP_QUEUE_SURFACE, 2);  // surface and shadow queues
-    reset_counters(p.queue_out, 1);
-    launch(Stage::kIntersectClosest, rays, p);
-    launch(Stage::kShadeSurface, rays, p);
-    launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
-    launch(Stage::kTraceShadow, rays, p);
-    launch(Stage::kSampleBsdf, rays, p);
-    launch(Stage::kRouletteCompact, rays, p);
-    rays = read_counter(p.queue_out);
-    std::swap(p.queue_in, p.queue_out);
-  }
-  launch(Stage::kAccumulate, count, p);
+  return p;
+}
+
+std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
+  reset_counters(WP_QUEUE_SURFACE, 2);  // surface and shadow queues
+  reset_counters(p.queue_out, 1);
+  launch(Stage::kIntersectClosest, rays, p);
+  launch(Stage::kShadeSurface, rays, p);
+  launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
+  launch(Stage::kTraceShadow, rays, p);
+  launch(Stage::kSampleBsdf, rays, p);
+  launch(Stage::kRouletteCompact, rays, p);
+  const std::uint32_t next = read_counter(p.queue_out);
+  std::swap(p.queue_in, p.queue_out);
+  return next;
+}
+
+Wavefront::Snapshot Wavefront::snapshot() {
+  Snapshot s;
+  s.paths.resize(path_state_.bytes);
+  s.slots.resize(WP_QUEUE_COUNT * wave_size_);
+  s.counters.resize(WP_COUNTER_COUNT);
+  auto& q = rt_.queue();
+  q.enqueueReadBuffer(path_buf_, CL_FALSE, 0, s.paths.size(), s.paths.data());
+  q.enqueueReadBuffer(queue_slots_, CL_FALSE, 0, s.slots.size() * sizeof(dev::uint),
+                      s.slots.data());
+  q.enqueueReadBuffer(counters_, CL_TRUE, 0, s.counters.size() * sizeof(dev::uint),
+                      s.counters.data());
+  return s;
+}
+
+void Wavefront::restore(const Snapshot& s) {
+  auto& q = rt_.queue();
+  q.enqueueWriteBuffer(path_buf_, CL_FALSE, 0, s.paths.size(), s.paths.data());
+  q.enqueueWriteBuffer(queue_slots_, CL_FALSE, 0, s.slots.size() * sizeof(dev::uint),
+                       s.slots.data());
+  q.enqueueWriteBuffer(counters_, CL_TRUE, 0, s.counters.size() * sizeof(dev::uint),
+                       s.counters.data());
 }
 
 void Wavefront::render_pass(std::uint32_t sample) {
@@ -194,18 +253,26 @@ void Wavefront::collect_profile() {
   pending_events_.clear();
 }
 
-std::vector<float> Wavefront::image(std::uint32_t samples) {
+FilmImages Wavefront::image(std::uint32_t samples) {
   const std::size_t pixels = std::size_t(settings_.width) * std::size_t(settings_.height);
-  std::vector<dev::float4> film(pixels);
-  rt_.queue().enqueueReadBuffer(film_, CL_TRUE, 0, pixels * sizeof(dev::float4), film.data());
-  std::vector<float> rgb(3 * pixels);
-  const float scale = samples ? 1.0f / static_cast<float>(samples) : 0.0f;
+  std::vector<dev::float4> film(2 * pixels);
+  rt_.queue().enqueueReadBuffer(film_, CL_TRUE, 0, film.size() * sizeof(dev::float4), film.data());
+  FilmImages out;
+  out.mean.resize(3 * pixels);
+  out.variance.resize(3 * pixels);
+  const double n = samples;
   for (std::size_t i = 0; i < pixels; ++i) {
-    rgb[3 * i + 0] = film[i].x * scale;
-    rgb[3 * i + 1] = film[i].y * scale;
-    rgb[3 * i + 2] = film[i].z * scale;
+    const float sum[3] = {film[2 * i].x, film[2 * i].y, film[2 * i].z};
+    const float sq[3] = {film[2 * i + 1].x, film[2 * i + 1].y, film[2 * i + 1].z};
+    for (int c = 0; c < 3; ++c) {
+      const double mean = n > 0 ? sum[c] / n : 0.0;
+      // Unbiased sample variance of one sample, divided by n: the variance of the mean.
+      const double var = n > 1 ? std::max(0.0, (sq[c] - n * mean * mean) / (n - 1)) / n : 0.0;
+      out.mean[3 * i + c] = static_cast<float>(mean);
+      out.variance[3 * i + c] = static_cast<float>(var);
+    }
   }
-  return rgb;
+  return out;
 }
 
 std::uint64_t Wavefront::nonfinite_samples() {

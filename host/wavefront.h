@@ -45,6 +45,12 @@ struct RenderSettings {
   std::size_t wave_size = 0;   // path slots per wave; 0: min(pixels, 2^20)
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
+  int bvh_width = 0;           // BVH layout: 2, 8, or 0 for the device's default (render.h)
+};
+
+struct FilmImages {
+  std::vector<float> mean;
+  std::vector<float> variance;
 };
 
 // Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
@@ -62,15 +68,18 @@ class Wavefront {
 
   // Renders sample index `sample` for every pixel and adds it to the film.
   void render_pass(std::uint32_t sample);
-  // The film divided by `samples`: linear RGB, row by row from the top, 3 floats per pixel.
-  std::vector<float> image(std::uint32_t samples);
+  // The film after `samples` passes: per pixel and channel the mean (the image: linear RGB, row by
+  // row from the top, 3 floats per pixel) and the variance of that mean estimated from the
+  // samples (sample variance / samples).
+  FilmImages image(std::uint32_t samples);
   // Samples the film rejected because they were NaN or infinite.
   std::uint64_t nonfinite_samples();
 
   // Stage-level access for tests and benchmarks. Field offsets are those of path_state().layout,
   // e.g. write_paths(path_state().layout.ray_o, rays).
-  void launch_stage(Stage stage, std::uint32_t items, const dev::Launch& params) {
-    launch(stage, items, params);
+  // Returns the launch's event (with profiling information: the queue profiles).
+  cl::Event launch_stage(Stage stage, std::uint32_t items, const dev::Launch& params) {
+    return launch(stage, items, params);
   }
   template <class T>
   void write_paths(dev::uint field_offset, const std::vector<T>& values) {
@@ -84,6 +93,21 @@ class Wavefront {
                                   values.data());
     return values;
   }
+  // The wave loop in steps, for benchmarks that capture a real wavefront: start_wave generates
+  // the camera rays of a wave and returns the launch parameters of its first bounce; run_bounce
+  // runs one bounce's stages on `rays` queued rays and returns the next bounce's count, leaving
+  // `params` ready for it.
+  dev::Launch start_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count);
+  std::uint32_t run_bounce(dev::Launch& params, std::uint32_t rays);
+  // The whole mutable device state except the film (path state, queues, counters), to replay a
+  // stage on the same input many times.
+  struct Snapshot {
+    std::vector<unsigned char> paths;
+    std::vector<dev::uint> slots, counters;
+  };
+  Snapshot snapshot();
+  void restore(const Snapshot& s);
+  std::uint32_t counter(std::uint32_t index) { return read_counter(index); }
   // Replaces queue `queue` (WP_QUEUE_*) with `slots` and sets its counter; zeroes the others.
   void write_queue(dev::uint queue, const std::vector<dev::uint>& slots);
   // Launch parameters of sample `sample` for the wave starting at `first_pixel`.
@@ -97,13 +121,19 @@ class Wavefront {
   std::size_t wave_size() const { return wave_size_; }
   const StageTimes& stage_times() const { return times_; }
   std::string build_options() const { return options_; }
+  // Seconds spent building the program and compiling every kernel (see prime_kernels).
+  double build_seconds() const { return build_seconds_; }
+  // Size of the device program binary (implementation-specific: LLVM bitcode on PoCL, PTX on
+  // NVIDIA), 0 if the implementation does not report one.
+  std::size_t binary_bytes() const { return binary_bytes_; }
 
  private:
   void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count);
-  void launch(Stage stage, std::uint32_t items, const dev::Launch& params);
+  cl::Event launch(Stage stage, std::uint32_t items, const dev::Launch& params);
   void reset_counters(std::uint32_t first, std::uint32_t count);
   std::uint32_t read_counter(std::uint32_t index);
   void collect_profile();
+  void prime_kernels();
 
   ClRuntime& rt_;
   RenderSettings settings_;
@@ -113,6 +143,8 @@ class Wavefront {
   PathStateLayout path_state_;
   std::size_t wave_size_ = 0;
   std::size_t local_size_ = 0;
+  double build_seconds_ = 0.0;
+  std::size_t binary_bytes_ = 0;
   std::string options_;
 
   cl::Buffer scene_buf_, path_buf_, queue_slots_, counters_, film_;

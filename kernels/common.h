@@ -36,17 +36,14 @@ inline void make_basis(float3 n, float3* t, float3* b) {
   *b = (float3)(c, s + n.y * n.y * a, -n.y);
 }
 
-/* A ray origin just off the surface at p on the side of unit normal n, robust at any scale: far
- * from the origin it moves p by a fixed number of float ULPs along n (so the offset grows with the
- * magnitude of p, as the rounding error of p does); near the origin, where ULPs are tiny, by a
- * small fixed distance. Secondary rays then start with tmin = 0. */
-inline float3 offset_origin(float3 p, float3 n) {
-  const float kNearOrigin = 1.0f / 32.0f;
-  const float kFloatScale = 1.0f / 65536.0f;
-  const float kIntScale = 256.0f;
-  const int3 ulps = convert_int3(kIntScale * n);
-  const float3 moved = as_float3(as_int3(p) + select(ulps, -ulps, as_int3(p) < 0));
-  return select(moved, p + kFloatScale * n, fabs(p) < kNearOrigin);
+/* A ray origin just off a surface point p, on the side of unit normal n, for rays that must not
+ * hit the surface they leave. `scale` bounds the magnitudes that went into computing p and into
+ * intersecting the surface again (the largest component of |b0 p0| + |b1 p1| + |b2 p2| for a point
+ * interpolated from a triangle's vertices: pbrt's error-bound idea): float rounding in both is a
+ * small multiple of 2^-24 scale, whatever the ray's angle, so moving the origin by 2^-16 scale
+ * along n clears it with a wide margin, at any scene scale and distance from the origin. */
+inline float3 offset_origin(float3 p, float3 n, float scale) {
+  return p + n * (scale * (1.0f / 65536.0f));
 }
 
 #endif /* WP_COMMON_H */

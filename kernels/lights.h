@@ -20,12 +20,14 @@
 #include "material.h"
 
 typedef struct LightSample {
-  float3 wi;  /* unit direction from the shading point toward the light */
-  float dist; /* distance to the light point (INFINITY for directional and environment) */
-  float3 li;  /* arriving radiance (area, environment) or irradiance (delta lights), before the
-                 cosine at the receiver and not divided by the pdf */
-  float pdf;  /* solid-angle pdf incl. the light choice; for delta lights the choice pmf alone */
-  bool delta; /* a delta light: no BSDF sample can find it (MIS weight 1) */
+  float3 wi;     /* unit direction from the shading point toward the light */
+  float dist;    /* distance to the light point (INFINITY for directional and environment) */
+  float3 li;     /* arriving radiance (area, environment) or irradiance (delta lights), before the
+                    cosine at the receiver and not divided by the pdf */
+  float pdf;     /* solid-angle pdf incl. the light choice; for delta lights the choice pmf alone */
+  bool delta;    /* a delta light: no BSDF sample can find it (MIS weight 1) */
+  float3 target; /* where a shadow ray stops (finite dist only): the light point, moved off an
+                    area light's surface toward the shading point so the ray cannot hit it */
 } LightSample;
 
 inline uint pick_light(const SceneView* scene, float u, float* pmf) {
@@ -56,6 +58,7 @@ inline LightSample sample_punctual(__global const Light* light, float3 p) {
   }
   const float4 pos = light->position;
   const float3 to_light = pos.xyz - p;
+  s.target = pos.xyz;
   const float d2 = dot(to_light, to_light);
   s.dist = sqrt(d2);
   s.wi = to_light / s.dist;
@@ -89,6 +92,8 @@ inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, f
   const float r = sqrt(u.x);
   const float b1 = r * (1.0f - u.y), b2 = r * u.y;
   const float3 q = p0 + b1 * e1 + b2 * e2;
+  const float3 p1 = p0 + e1, p2 = p0 + e2;
+  const float q_scale = max3(fabs((1.0f - b1 - b2) * p0) + fabs(b1 * p1) + fabs(b2 * p2));
   const float3 n = cross(e1, e2);
   const float area2 = length(n);
   const float3 to_light = q - p;
@@ -98,6 +103,7 @@ inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, f
   const bool double_sided = scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED;
   if (!(s.dist > 0.0f) || !(cos_light > 0.0f || (double_sided && cos_light < 0.0f))) return s;
   s.pdf = triangle_solid_angle_pdf(0.5f * area2, s.dist, cos_light);
+  s.target = offset_origin(q, cos_light > 0.0f ? n / area2 : -n / area2, q_scale);
   s.li = material_emission(scene, tv, b1, b2);
   return s;
 }

@@ -21,6 +21,8 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   }
   paths.throughput[slot] = (float4)(beta.xyz * bs.weight, bs.pdf);
   paths.info[slot].z = bs.delta ? WP_PATH_DELTA : 0u;
-  paths.ray_o[slot] = (float4)(offset_origin(s.p, s.ng), 0.0f);
+  /* Leave on the side the new direction goes to (below for transmission). */
+  paths.ray_o[slot] =
+      (float4)(offset_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng, s.p_scale), 0.0f);
   paths.ray_d[slot] = (float4)(bs.wi, INFINITY);
 }

@@ -25,12 +25,18 @@ __kernel void sample_lights(WP_STAGE_PARAMS) {
   const float3 c = paths.throughput[slot].xyz * e.f * ls.li * (fabs(dot(s.ns, ls.wi)) * w / ls.pdf);
   if (!(max3(c) > 0.0f)) return;
   /* The shadow ray leaves the side of the surface the light is on (transmission can light the
-   * back) and stops short of an area light's surface by the same robust offset. */
-  const float3 o = offset_origin(s.p, dot(s.ng, ls.wi) > 0.0f ? s.ng : -s.ng);
-  float tmax = ls.dist;
-  if (ls.dist < INFINITY) tmax = length(s.p + ls.wi * ls.dist - o) * (1.0f - 1e-5f);
+   * back) and, for a light at a finite distance, runs from the moved origin to the light's target
+   * point (itself moved off an area light's surface): neither end can hit the surface it is on. */
+  const float3 o = offset_origin(s.p, dot(s.ng, ls.wi) > 0.0f ? s.ng : -s.ng, s.p_scale);
+  float3 dir = ls.wi;
+  float tmax = INFINITY;
+  if (ls.dist < INFINITY) {
+    const float3 to = ls.target - o;
+    tmax = length(to);
+    dir = to / tmax;
+  }
   paths.shadow_o[slot] = (float4)(o, tmax);
-  paths.shadow_d[slot] = (float4)(ls.wi, 0.0f);
+  paths.shadow_d[slot] = (float4)(dir, 0.0f);
   paths.shadow_l[slot] = (float4)(c, 0.0f);
   queue_push(queues, WP_QUEUE_SHADOW, slot);
 #endif

@@ -15,7 +15,7 @@ __kernel void shade_surface(WP_STAGE_PARAMS) {
   uint slot;
   if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
   const float4 hit = paths.hit[slot];
-  const float4 beta = paths.throughput[slot]; /* w: pdf of the BSDF sample (0: delta or camera) */
+  float4 beta = paths.throughput[slot]; /* w: pdf of the BSDF sample (0: delta or camera) */
   const float3 ray_d = paths.ray_d[slot].xyz;
   if (!(hit.x < INFINITY)) {
     const float w = mis_weight_bsdf_hit(beta.w, environment_light_pdf(&scene, ray_d));
@@ -26,6 +26,15 @@ __kernel void shade_surface(WP_STAGE_PARAMS) {
   const uint4 tv = scene.tri_vertices[tri];
   bool front;
   const Surface s = resolve_surface(&scene, tv, hit.y, hit.z, ray_d, &front);
+#if WP_FEATURE_VOLUME
+  /* A ray that reaches the back of a volume travelled inside it: Beer-Lambert absorption with
+   * transmittance attenuationColor^(distance / attenuationDistance) (KHR_materials_volume). */
+  const float4 vol = scene.materials[tv.w].volume;
+  if (!front && (s.flags & WP_SURF_VOLUME) && vol.w < INFINITY) {
+    beta.xyz *= pow(vol.xyz, hit.x / vol.w);
+    paths.throughput[slot] = beta;
+  }
+#endif
 #if WP_FEATURE_EMISSION
   if (front || (scene.materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) {
     const float3 le = material_emission(&scene, tv, hit.y, hit.z);

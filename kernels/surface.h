@@ -6,8 +6,8 @@
 #include "path_state.h"
 
 inline void surface_store(Paths paths, uint slot, const Surface* s) {
-  paths.surf_p[slot] = (float4)(s->p, 0.0f);
-  paths.surf_ng[slot] = (float4)(s->ng, 0.0f);
+  paths.surf_p[slot] = (float4)(s->p, s->p_scale);
+  paths.surf_ng[slot] = (float4)(s->ng, s->specular);
   paths.surf_ns[slot] = (float4)(s->ns, 0.0f);
   paths.surf_color[slot] = (float4)(s->color, s->metallic);
   paths.surf_params[slot] = (float4)(s->roughness, s->ior, s->transmission, as_float(s->flags));
@@ -15,8 +15,12 @@ inline void surface_store(Paths paths, uint slot, const Surface* s) {
 
 inline Surface surface_load(Paths paths, uint slot) {
   Surface s;
-  s.p = paths.surf_p[slot].xyz;
-  s.ng = paths.surf_ng[slot].xyz;
+  const float4 p = paths.surf_p[slot];
+  s.p = p.xyz;
+  s.p_scale = p.w;
+  const float4 ng = paths.surf_ng[slot];
+  s.ng = ng.xyz;
+  s.specular = ng.w;
   s.ns = paths.surf_ns[slot].xyz;
   const float4 c = paths.surf_color[slot];
   const float4 q = paths.surf_params[slot];

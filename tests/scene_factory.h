@@ -36,9 +36,10 @@ inline void add_quad(Scene& scene, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::v
   add_mesh(scene, {a, b, c, d}, {n, n, n, n}, {0, 1, 2, 0, 2, 3}, material);
 }
 
-// A UV sphere with smooth normals, front faces outward.
+// A UV sphere, front faces outward; smooth normals, or with `flat` each facet's own normal (then
+// shading and geometric normals agree, as exact energy tests need).
 inline void add_sphere(Scene& scene, glm::vec3 center, float radius, int rings, int segments,
-                       std::uint32_t material) {
+                       std::uint32_t material, bool flat = false) {
   std::vector<glm::vec3> p, n;
   std::vector<std::uint32_t> idx;
   for (int r = 0; r <= rings; ++r) {
@@ -61,6 +62,21 @@ inline void add_sphere(Scene& scene, glm::vec3 center, float radius, int rings, 
       if (r > 0) idx.insert(idx.end(), {at(r, s), at(r, s + 1), at(r + 1, s)});
       if (r < rings - 1) idx.insert(idx.end(), {at(r, s + 1), at(r + 1, s + 1), at(r + 1, s)});
     }
+  if (flat) {
+    std::vector<glm::vec3> fp, fn;
+    std::vector<std::uint32_t> fi;
+    for (std::size_t t = 0; t < idx.size(); t += 3) {
+      const glm::vec3 a = p[idx[t]], b = p[idx[t + 1]], c = p[idx[t + 2]];
+      const glm::vec3 nn = glm::normalize(glm::cross(b - a, c - a));
+      for (const glm::vec3& v : {a, b, c}) {
+        fi.push_back(static_cast<std::uint32_t>(fp.size()));
+        fp.push_back(v);
+        fn.push_back(nn);
+      }
+    }
+    add_mesh(scene, fp, fn, fi, material);
+    return;
+  }
   add_mesh(scene, p, n, idx, material);
 }
 
@@ -84,6 +100,23 @@ inline void add_random_soup(Scene& scene, int count, float size, std::uint32_t s
     }
   }
   add_mesh(scene, p, n, idx, material);
+}
+
+// A cube of half size h around `center`, turned by `angle` radians about the axis (1, 1, 0), flat
+// faces outward.
+inline void add_cube(Scene& scene, glm::vec3 center, float h, float angle, std::uint32_t material) {
+  const glm::vec3 axis = glm::normalize(glm::vec3(1.0f, 1.0f, 0.0f));
+  const auto turn = [&](glm::vec3 v) {  // Rodrigues' rotation
+    const float c = std::cos(angle), s = std::sin(angle);
+    return center + v * c + glm::cross(axis, v) * s + axis * glm::dot(axis, v) * (1.0f - c);
+  };
+  const glm::vec3 corner[8] = {{-h, -h, -h}, {h, -h, -h}, {h, h, -h}, {-h, h, -h},
+                               {-h, -h, h},  {h, -h, h},  {h, h, h},  {-h, h, h}};
+  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                           {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+  for (const auto& f : faces)
+    add_quad(scene, turn(corner[f[0]]), turn(corner[f[1]]), turn(corner[f[2]]), turn(corner[f[3]]),
+             material);
 }
 
 inline Material diffuse_material(glm::vec3 color, bool double_sided = true) {

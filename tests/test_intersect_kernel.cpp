@@ -118,8 +118,22 @@ class IntersectKernel : public ::testing::Test {
   }
 
   // Traces `rays` through intersect_closest and compares with rtcIntersect1.
+  // Both BVH layouts: the binary one (GPUs) and the wide one (CPUs).
   void check_closest(const wp::Scene& scene, const Rays& rays) {
-    const wp::bvh::Bvh bvh = build(scene);
+    for (int width : {2, 8}) {
+      SCOPED_TRACE("BVH width " + std::to_string(width));
+      check_closest(scene, rays, width);
+    }
+  }
+  void check_shadow(const wp::Scene& scene, std::size_t count, std::uint32_t seed) {
+    for (int width : {2, 8}) {
+      SCOPED_TRACE("BVH width " + std::to_string(width));
+      check_shadow(scene, count, seed, width);
+    }
+  }
+
+  void check_closest(const wp::Scene& scene, const Rays& rays, int width) {
+    const wp::bvh::Bvh bvh = build(scene, width);
     wp::Wavefront wf(*runtime_, scene, bvh, settings());
     EmbreeScene embree(scene);
     std::size_t ties = 0, hits = 0;
@@ -169,8 +183,8 @@ class IntersectKernel : public ::testing::Test {
   }
 
   // Shadow segments between random points; compares trace_shadow with rtcOccluded1.
-  void check_shadow(const wp::Scene& scene, std::size_t count, std::uint32_t seed) {
-    const wp::bvh::Bvh bvh = build(scene);
+  void check_shadow(const wp::Scene& scene, std::size_t count, std::uint32_t seed, int width) {
+    const wp::bvh::Bvh bvh = build(scene, width);
     wp::Wavefront wf(*runtime_, scene, bvh, settings());
     EmbreeScene embree(scene);
     std::mt19937 rng(seed);
@@ -215,12 +229,14 @@ class IntersectKernel : public ::testing::Test {
     EXPECT_LT(occluded, total - total / 20);
   }
 
-  static wp::bvh::Bvh build(const wp::Scene& s) {
+  static wp::bvh::Bvh build(const wp::Scene& s, int width) {
     wp::bvh::BuildInput in;
     in.positions = s.positions.data();
     in.indices = s.indices.data();
     in.triangle_count = s.triangle_count();
-    return wp::bvh::build(in);
+    wp::bvh::BuildOptions options;
+    options.width = width;
+    return wp::bvh::build(in, options);
   }
   static wp::RenderSettings settings() {
     wp::RenderSettings s;
