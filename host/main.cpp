@@ -33,6 +33,7 @@ struct CliOptions {
   std::string light_select = "power";
   bool no_rr = false;
   bool variance = false;
+  bool no_bvh_cache = false;
   std::string features = "scene";
   std::string tonemap = "aces";
   float exposure = 0.0f;
@@ -112,6 +113,7 @@ int render_command(CliOptions& cli, wp::RenderSettings& settings) {
   wp::ClRuntime runtime(wp::select_device(cli.device));
   wp::RenderOptions options;
   options.bvh.spatial_splits = cli.spatial_splits;
+  options.bvh_cache = !cli.no_bvh_cache;
   options.progress = Progress(!cli.quiet && isatty(STDERR_FILENO));
   const wp::Rendered result = wp::render(runtime, scene, settings, options);
 
@@ -217,6 +219,9 @@ int main(int argc, char** argv) {
                      "BVH layout: 2 (binary) or 8 (wide, float8 box tests) [default: 2 on GPUs, "
                      "8 on CPUs]");
   render->add_option("--local-size", settings.local_size, "Work-group size [default: 64]");
+  render->add_flag("--no-bvh-cache", cli.no_bvh_cache,
+                   "Build the BVH afresh; by default it is looked up in and stored to "
+                   "$WAVEPATH_CACHE_DIR, else $XDG_CACHE_HOME/wavepath, else ~/.cache/wavepath");
   render->add_flag("--variance", cli.variance,
                    "Also write the variance of each pixel's estimate (sample variance / spp): the "
                    "layer variance.R/G/B in EXR output, X.variance.pfm beside X.pfm");

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "bvh/bvh_cache.h"
 #include "host/error.h"
 
 namespace wp {
@@ -60,7 +61,10 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   std::vector<std::uint32_t> flags;
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
-  const bvh::Bvh bvh = bvh::build(bvh_input(scene, flags), bvh_options);
+  bool cached = false;
+  const bvh::Bvh bvh =
+      bvh::build_cached(bvh_input(scene, flags), bvh_options,
+                        options.bvh_cache ? bvh::cache_dir() : std::string(), &cached);
 
   Wavefront wavefront(runtime, scene, bvh, settings);
 
@@ -71,6 +75,7 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.build_options = wavefront.build_options();
   r.triangles = scene.triangle_count();
   r.bvh = bvh.stats;
+  r.bvh_cached = cached;
   r.kernel_build_seconds = wavefront.build_seconds();
   r.kernel_binary_bytes = wavefront.binary_bytes();
   r.setup_seconds = since(start);

@@ -19,7 +19,8 @@ struct RenderReport {
   std::string features;       // the kernel features the program was built with
   std::string build_options;  // the program's build options
   std::size_t triangles = 0;
-  bvh::BuildStats bvh;
+  bvh::BuildStats bvh;   // build_seconds: of the build, or of the cache look-up when cached
+  bool bvh_cached = false;  // loaded from the BVH cache (bvh/bvh_cache.h)
   double kernel_build_seconds = 0;  // includes the OpenCL implementation's cache lookup
   std::size_t kernel_binary_bytes = 0;
   double setup_seconds = 0;       // BVH, upload, program: from scene to first pass
@@ -35,7 +36,8 @@ struct RenderReport {
 };
 
 struct RenderOptions {
-  bvh::BuildOptions bvh;
+  bvh::BuildOptions bvh;  // the width is set per device (bvh_width)
+  bool bvh_cache = false;  // look the BVH up in, and store it to, bvh::cache_dir()
   // Called after each sample pass with (passes done, passes in all, seconds since the start).
   std::function<void(int, int, double)> progress;
 };

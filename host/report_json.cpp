@@ -76,7 +76,9 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)
     << ",\"kernel_binary_bytes\":" << r.kernel_binary_bytes
     << ",\"bvh_build_seconds\":" << num(r.bvh.build_seconds)
-    << ",\"bvh_sah_cost\":" << num(r.bvh.sah_cost) << ",\"setup_seconds\":" << num(r.setup_seconds)
+    << ",\"bvh_sah_cost\":" << num(r.bvh.sah_cost)
+    << ",\"bvh_cached\":" << (r.bvh_cached ? "true" : "false")
+    << ",\"setup_seconds\":" << num(r.setup_seconds)
     << ",\"first_pass_seconds\":" << num(r.first_pass_seconds)
     << ",\"load_seconds\":" << num(load_seconds) << ",\"total_seconds\":" << num(total_seconds)
     << ",\"nonfinite_samples\":" << r.nonfinite_samples

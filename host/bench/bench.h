@@ -24,8 +24,10 @@ struct Options {
   std::vector<SceneSpec> scenes;
   int width = 640;
   int height = 480;
-  std::string device;          // --device: index or name substring; empty: the default device
-  bool user_min_time = false;  // --benchmark_min_time given: no benchmark sets its own
+  std::string device;           // --device: index or name substring; empty: the default device
+  int bvh_width = 0;            // --bvh-width 2|8; 0: the device's default (render.h)
+  bool spatial_splits = false;  // --spatial-splits
+  bool user_min_time = false;   // --benchmark_min_time given: no benchmark sets its own
 };
 
 // Set once in main before any benchmark runs.

@@ -26,6 +26,7 @@ RenderSettings bench_settings(bool profile) {
   s.height = env().options.height;
   s.background = glm::vec3(1.0f);
   s.profile = profile;
+  s.bvh_width = env().options.bvh_width;
   return s;
 }
 
@@ -52,6 +53,8 @@ constexpr const char* kUsage =
     "  --width N       image width in pixels (default 640)\n"
     "  --height N      image height in pixels (default 480)\n"
     "  --device D      OpenCL device index or name substring (default: first GPU, else CPU)\n"
+    "  --bvh-width W   BVH layout, 2 or 8 (default: 2 on GPUs, 8 on CPUs)\n"
+    "  --spatial-splits  build the BVH with spatial splits\n"
     "\n"
     "Benchmarks: <stage>/bounce<0|1>/<scene> and accumulate/final/<scene> (one kernel launch on\n"
     "captured state, device time), render/<scene>, bvh_build/<scene>, program_build/<scene>.\n"
@@ -111,7 +114,11 @@ Options parse_options(int& argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i], value;
     bool own = false;
-    for (const char* name : {"--scene", "--width", "--height", "--device"}) {
+    if (arg == "--spatial-splits") {
+      o.spatial_splits = true;
+      continue;
+    }
+    for (const char* name : {"--scene", "--width", "--height", "--device", "--bvh-width"}) {
       const std::string n = name;
       if (arg == n) {
         if (i + 1 >= argc) throw Error(n + " needs a value");
@@ -135,6 +142,10 @@ Options parse_options(int& argc, char** argv) {
     if (arg == "--width") o.width = parse_size(arg, value);
     if (arg == "--height") o.height = parse_size(arg, value);
     if (arg == "--device") o.device = value;
+    if (arg == "--bvh-width") {
+      o.bvh_width = parse_size(arg, value);
+      if (o.bvh_width != 2 && o.bvh_width != 8) throw Error("--bvh-width must be 2 or 8");
+    }
   }
   argc = kept;
   argv[argc] = nullptr;

@@ -79,7 +79,7 @@ void run_bvh_build(benchmark::State& state, const SceneSpec& spec) {
   SceneBench& sb = scene_bench(spec);
   bvh::BuildStats stats;
   for (auto _ : state) {
-    const bvh::Bvh bvh = bvh::build(sb.bvh_input());
+    const bvh::Bvh bvh = bvh::build(sb.bvh_input(), build_options());
     stats = bvh.stats;
   }
   state.counters["sah_cost"] = stats.sah_cost;

@@ -4,6 +4,7 @@
 
 #include "host/device_scene.h"
 #include "host/gltf_loader.h"
+#include "host/render.h"
 
 namespace wp::bench {
 
@@ -22,28 +23,20 @@ bool in_bounce(Stage s) {
 
 }  // namespace
 
-bvh::BuildInput build_input(const Scene& scene, std::vector<std::uint32_t>& flags) {
-  flags.assign(scene.triangle_count(), 0u);
-  for (std::size_t i = 0; i < flags.size(); ++i) {
-    const Material& m = scene.materials[scene.triangle_material[i]];
-    const bool cull = !m.double_sided && !(m.transmission > 0.0f && m.thickness > 0.0f);
-    flags[i] = (cull ? WP_TRI_CULL_BACKFACE : 0u) |
-               (m.alpha_mode != AlphaMode::kOpaque ? WP_TRI_ALPHA : 0u);
-  }
-  bvh::BuildInput in;
-  in.positions = scene.positions.data();
-  in.indices = scene.indices.data();
-  in.triangle_count = scene.triangle_count();
-  in.triangle_flags = flags.data();
-  return in;
-}
-
 SceneBench::SceneBench(const SceneSpec& spec)
-    : spec_(spec), scene_(load_gltf(spec.path)), bvh_input_(build_input(scene_, tri_flags_)) {
-  bvh_ = bvh::build(bvh_input_);
+    : spec_(spec), scene_(load_gltf(spec.path)), bvh_input_(wp::bvh_input(scene_, tri_flags_)) {
+  bvh_ = bvh::build(bvh_input_, build_options());
   const RenderSettings s = bench_settings(false);
   const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
   wave_paths_ = static_cast<std::uint32_t>(std::min(pixels, std::size_t(1) << 20));
+}
+
+// The BVH options a render on the bench's device would use.
+bvh::BuildOptions build_options() {
+  bvh::BuildOptions o;
+  o.width = bvh_width(env().runtime->device(), bench_settings(false));
+  o.spatial_splits = env().options.spatial_splits;
+  return o;
 }
 
 Wavefront& SceneBench::stages() {

@@ -96,6 +96,7 @@ void release_scene_bench();
 
 // The BVH build input of `scene` as the renderer makes it (render.cpp): per-triangle flags for
 // back-face culling and alpha, filled into `flags`, which must outlive the input.
-bvh::BuildInput build_input(const Scene& scene, std::vector<std::uint32_t>& flags);
+// The BVH options a render on the bench's device would use (width, spatial splits).
+bvh::BuildOptions build_options();
 
 }  // namespace wp::bench
