@@ -16,6 +16,7 @@
 #define WP_TEXTURES_H
 
 #include "scene.h"
+#include "srgb_lut.h"
 
 /* The sRGB EOTF (IEC 61966-2-1): encoded value c in [0, 1] to linear. */
 inline float srgb_to_linear(float c) {
@@ -28,7 +29,9 @@ inline float4 texel_fetch(__global const uint* texels, TextureImage img, int x, 
   float4 c = (float4)((float)(p & 0xffu), (float)((p >> 8) & 0xffu), (float)((p >> 16) & 0xffu),
                       (float)(p >> 24)) *
              (1.0f / 255.0f);
-  if (srgb) c.xyz = (float3)(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z));
+  if (srgb) /* the table holds srgb_to_linear of every code */
+    c.xyz = (float3)(wp_srgb_lut[p & 0xffu], wp_srgb_lut[(p >> 8) & 0xffu],
+                     wp_srgb_lut[(p >> 16) & 0xffu]);
   return c;
 }
 

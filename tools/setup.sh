@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(
-  build-essential cmake pkg-config python3
+  build-essential cmake pkg-config python3 python3-numpy python3-matplotlib
   opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd
   libembree-dev libtinygltf-dev libglm-dev libopenexr-dev libstb-dev libcli11-dev
   libgtest-dev libbenchmark-dev
