@@ -13,6 +13,8 @@
 #include <vector>
 
 #include <embree3/rtcore.h>
+
+#include "bvh/embree_scene.h"
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
@@ -164,6 +166,21 @@ inline Mesh exponential_clusters(int clusters, int per_cluster) {
   return m;
 }
 
+// The meshes every layout's invariants are checked on: tiny, large, smooth, regular, degenerate,
+// long and thin, and deep (clusters at exponentially shrinking scales).
+inline std::vector<std::pair<const char*, Mesh>> invariant_meshes() {
+  return {{"1 triangle", soup(1, 1, 0.3f)},
+          {"2 triangles", soup(2, 2, 0.3f)},
+          {"7 triangles", soup(7, 3, 0.3f)},
+          {"soup 1000", soup(1000, 4, 0.05f)},
+          {"soup 200k", soup(200000, 5, 0.01f)},
+          {"sphere", sphere(48, 96)},
+          {"grid", grid(80)},
+          {"degenerate", degenerate()},
+          {"long diagonals", long_diagonals(3000, 6, 0.01f)},
+          {"exponential clusters", exponential_clusters(100, 500)}};
+}
+
 inline float scene_size(const Bvh& bvh) {
   return glm::length(bvh.hi - bvh.lo);
 }
@@ -197,62 +214,11 @@ inline Hit brute_force(const std::vector<dev::IsectTri>& tris, const Ray& ray) {
 // Intersectors
 
 // Embree's own BVH and intersector over the same triangles: the independent oracle.
-class EmbreeScene {
+class EmbreeScene : public wp::bvh::EmbreeScene {
  public:
-  explicit EmbreeScene(const Mesh& m) : device_(rtcNewDevice(nullptr)) {
-    scene_ = rtcNewScene(device_);
-    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.positions.size()));
-    std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(glm::vec3));
-    auto* i = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), m.triangles()));
-    std::memcpy(i, m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(scene_, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(scene_);
-  }
-  ~EmbreeScene() {
-    rtcReleaseScene(scene_);
-    rtcReleaseDevice(device_);
-  }
-  EmbreeScene(const EmbreeScene&) = delete;
-  EmbreeScene& operator=(const EmbreeScene&) = delete;
-
-  Hit intersect(const Ray& r) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRayHit rh{};
-    rh.ray = to_rtc(r);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &ctx, &rh);
-    Hit h;
-    h.hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    h.t = rh.ray.tfar, h.u = rh.hit.u, h.v = rh.hit.v, h.triangle = rh.hit.primID;
-    return h;
-  }
-  bool occluded(const Ray& r) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRay ray = to_rtc(r);
-    rtcOccluded1(scene_, &ctx, &ray);
-    return ray.tfar < 0;  // Embree marks an occluded ray with tfar = -inf
-  }
-
- private:
-  // Embree accepts t in [tnear, tfar], the reference (tmin, tmax): they differ only on the bounds.
-  static RTCRay to_rtc(const Ray& r) {
-    RTCRay ray{};
-    ray.org_x = r.o.x, ray.org_y = r.o.y, ray.org_z = r.o.z, ray.tnear = r.tmin;
-    ray.dir_x = r.d.x, ray.dir_y = r.d.y, ray.dir_z = r.d.z, ray.tfar = r.tmax;
-    ray.mask = ~0u;
-    return ray;
-  }
-  RTCDevice device_;
-  RTCScene scene_ = nullptr;
+  explicit EmbreeScene(const Mesh& m)
+      : wp::bvh::EmbreeScene(m.positions.data(), m.positions.size(), m.indices.data(),
+                             m.triangles(), /*robust=*/true) {}
 };
 
 // Camera rays from outside the bounds through a jittered pixel grid, with tmax = +INFINITY as the

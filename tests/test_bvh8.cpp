@@ -93,17 +93,7 @@ void expect_valid(const Mesh& mesh, const BuildOptions& options) {
 }
 
 TEST(Bvh8Build, InvariantsHoldOnManyMeshes) {
-  const std::vector<std::pair<const char*, Mesh>> meshes = {
-      {"1 triangle", soup(1, 1, 0.3f)},
-      {"2 triangles", soup(2, 2, 0.3f)},
-      {"7 triangles", soup(7, 3, 0.3f)},
-      {"soup 1000", soup(1000, 4, 0.05f)},
-      {"soup 200k", soup(200000, 5, 0.01f)},
-      {"sphere", sphere(48, 96)},
-      {"grid", grid(80)},
-      {"degenerate", degenerate()},
-      {"long diagonals", long_diagonals(3000, 6, 0.01f)},
-      {"exponential clusters", exponential_clusters(100, 500)}};
+  const std::vector<std::pair<const char*, Mesh>> meshes = invariant_meshes();
   for (const auto& [name, mesh] : meshes)
     for (const bool splits : {false, true})
       for (const int leaf : {1, 4, 8, 16}) {

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
+#include "bvh/embree_scene.h"
 #include "host/cl_runtime.h"
 #include "host/gltf_loader.h"
 #include "host/wavefront.h"
@@ -28,31 +29,11 @@ using wp::dev::float4;
 
 constexpr std::uint32_t kWave = 1u << 16;
 
-struct EmbreeScene {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  explicit EmbreeScene(const wp::Scene& s) {
-    device = rtcNewDevice(nullptr);
-    scene = rtcNewScene(device);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), s.positions.size()));
-    for (std::size_t i = 0; i < s.positions.size(); ++i)
-      for (int k = 0; k < 3; ++k) v[3 * i + k] = s.positions[i][k];
-    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), s.triangle_count()));
-    std::copy(s.indices.begin(), s.indices.end(), idx);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(scene, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(scene);
-  }
-  ~EmbreeScene() {
-    rtcReleaseScene(scene);
-    rtcReleaseDevice(device);
-  }
+// Embree over the scene's triangles (robust mode): the oracle.
+struct EmbreeScene : wp::bvh::EmbreeScene {
+  explicit EmbreeScene(const wp::Scene& s)
+      : wp::bvh::EmbreeScene(s.positions.data(), s.positions.size(), s.indices.data(),
+                             s.triangle_count(), /*robust=*/true) {}
 };
 
 struct Rays {
@@ -156,7 +137,7 @@ class IntersectKernel : public ::testing::Test {
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
-        rtcIntersect1(embree.scene, &ctx, &rh);
+        rtcIntersect1(embree.handle(), &ctx, &rh);
         const bool ours = hit[i].x < INFINITY, theirs = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
         std::uint32_t our_tri;
         std::memcpy(&our_tri, &hit[i].w, 4);
@@ -216,7 +197,7 @@ class IntersectKernel : public ::testing::Test {
                    sd[i].z, 0.0f,    so[i].w, ~0u,  0,       0};
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
-        rtcOccluded1(embree.scene, &ctx, &ray);
+        rtcOccluded1(embree.handle(), &ctx, &ray);
         const bool theirs = ray.tfar < 0.0f, ours = radiance[i].x == 0.0f;
         occluded += theirs;
         mismatches += ours != theirs;

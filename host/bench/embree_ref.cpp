@@ -59,42 +59,19 @@ double run_passes(RTCScene scene, const std::vector<RefRay>& rays, bool occlusio
 
 }  // namespace
 
-EmbreeRef::EmbreeRef(const Scene& s) {
-  device_ = rtcNewDevice(nullptr);
-  if (!device_) throw Error("Embree: cannot create a device");
-  scene_ = rtcNewScene(device_);
-  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
-  RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-      g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), s.positions.size()));
-  for (std::size_t i = 0; i < s.positions.size(); ++i)
-    for (int k = 0; k < 3; ++k) v[3 * i + k] = s.positions[i][k];
-  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-      g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), s.triangle_count()));
-  std::copy(s.indices.begin(), s.indices.end(), idx);
-  rtcCommitGeometry(g);
-  rtcAttachGeometry(scene_, g);
-  rtcReleaseGeometry(g);
-  rtcCommitScene(scene_);
-  if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
-    throw Error("Embree: building the reference scene of " + s.source + " failed");
-}
-
-EmbreeRef::~EmbreeRef() {
-  rtcReleaseScene(scene_);
-  rtcReleaseDevice(device_);
-}
+EmbreeRef::EmbreeRef(const Scene& s)
+    : scene_(s.positions.data(), s.positions.size(), s.indices.data(), s.triangle_count(),
+             /*robust=*/false) {}
 
 RefTiming EmbreeRef::measure(const std::vector<RefRay>& rays, bool occlusion, unsigned threads,
                              double min_seconds) const {
   RefTiming t;
   if (rays.empty()) return t;
   threads = std::max(threads, 1u);
-  const double warm = run_passes(scene_, rays, occlusion, threads, 1, t.hits);
+  const double warm = run_passes(scene_.handle(), rays, occlusion, threads, 1, t.hits);
   t.passes = static_cast<std::size_t>(
       std::clamp(std::ceil(min_seconds / std::max(warm, 1e-6)), 1.0, 10000.0));
-  t.seconds_per_pass = run_passes(scene_, rays, occlusion, threads, t.passes, t.hits) /
+  t.seconds_per_pass = run_passes(scene_.handle(), rays, occlusion, threads, t.passes, t.hits) /
                        static_cast<double>(t.passes);
   return t;
 }

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <vector>
 
-#include <embree3/rtcore.h>
+#include "bvh/embree_scene.h"
 
 #include "host/scene.h"
 
@@ -30,9 +30,6 @@ class EmbreeRef {
   // An Embree scene over the scene's world-space triangles, built with RTC_BUILD_QUALITY_HIGH
   // (spatial splits) and default scene flags: Embree at its fastest for single rays.
   explicit EmbreeRef(const Scene& scene);
-  ~EmbreeRef();
-  EmbreeRef(const EmbreeRef&) = delete;
-  EmbreeRef& operator=(const EmbreeRef&) = delete;
 
   // Traces every ray once untimed (warm-up), then repeatedly for at least `min_seconds` (and at
   // least one pass), `threads` workers taking chunks of rays from a shared counter.
@@ -40,8 +37,7 @@ class EmbreeRef {
                     double min_seconds) const;
 
  private:
-  RTCDevice device_ = nullptr;
-  RTCScene scene_ = nullptr;
+  bvh::EmbreeScene scene_;
 };
 
 }  // namespace wp::bench

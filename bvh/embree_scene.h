@@ -1,0 +1,38 @@
+// Embree's own acceleration structure and single-ray queries (rtcIntersect1 / rtcOccluded1) over
+// a triangle mesh: the independent oracle the tests compare the reference traversal and the
+// kernels with, and the reference the benchmarks time them against.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "bvh.h"
+
+namespace wp::bvh {
+
+class EmbreeScene {
+ public:
+  // RTC_BUILD_QUALITY_HIGH; `robust` adds RTC_SCENE_FLAG_ROBUST (watertight-ish, slower: for
+  // tests). Throws wp::Error if Embree fails.
+  EmbreeScene(const glm::vec3* positions, std::size_t vertex_count, const std::uint32_t* indices,
+              std::size_t triangle_count, bool robust);
+  ~EmbreeScene();
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  // Embree accepts t in [tmin, tmax], the project's traversals (tmin, tmax): they differ only on
+  // the bounds.
+  Hit intersect(const Ray& ray) const;
+  bool occluded(const Ray& ray) const;
+  RTCScene handle() const { return scene_; }
+
+  static RTCRay to_rtc(const Ray& r);
+
+ private:
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+};
+
+}  // namespace wp::bvh
