@@ -10,12 +10,14 @@
 // pixel blocks first, which brings them close to Gaussian.
 #include <cmath>
 #include <functional>
+#include <memory>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include "host/cl_runtime.h"
 #include "host/device_scene.h"
+#include "host/environment.h"
 #include "host/image_io.h"
 #include "host/render.h"
 #include "tests/scene_factory.h"
@@ -209,9 +211,37 @@ wp::RenderSettings agreement_settings() {
   return st;
 }
 
-TEST_F(LightTransport, StrategiesAgree) {
+// A small equirectangular sky (host/environment.h's convention): a gradient from 0.1 at the
+// horizon to 0.4 at the zenith, dark below, and a broad bright "sun" (15 degrees, radiance 6)
+// that BSDF sampling still finds often enough for its estimate to be close to Gaussian per block.
+std::shared_ptr<const wp::EnvironmentMap> test_sky() {
+  auto env = std::make_shared<wp::EnvironmentMap>();
+  env->width = 64;
+  env->height = 32;
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.6, 0.7, -0.4));
+  for (int y = 0; y < env->height; ++y)
+    for (int x = 0; x < env->width; ++x) {
+      const double theta = M_PI * (y + 0.5) / env->height;
+      const double phi = 2.0 * M_PI * (x + 0.5) / env->width - M_PI;
+      const glm::dvec3 d(std::sin(theta) * std::sin(phi), std::cos(theta),
+                         -std::sin(theta) * std::cos(phi));
+      double l = d.y > 0.0 ? 0.1 + 0.3 * d.y : 0.02;
+      if (glm::dot(d, sun) > std::cos(15.0 * M_PI / 180.0)) l += 6.0;
+      env->texels.emplace_back(static_cast<float>(l), static_cast<float>(0.9 * l),
+                               static_cast<float>(0.8 * l), 0.0f);
+    }
+  wp::build_environment_tables(*env);
+  return env;
+}
+
+class StrategiesAgree : public LightTransport, public ::testing::WithParamInterface<bool> {};
+
+// With the constant sky and with an environment map (the scene: an emissive quad, a glossy
+// surface and an environment map).
+TEST_P(StrategiesAgree, MisNeeAndBsdf) {
   const wp::Scene s = agreement_scene();
   wp::RenderSettings st = agreement_settings();
+  if (GetParam()) st.environment = test_sky();
   st.strategy = wp::Strategy::kMis;
   const wp::Rendered mis = render(s, st);
   st.strategy = wp::Strategy::kNee;
@@ -224,6 +254,10 @@ TEST_F(LightTransport, StrategiesAgree) {
   expect_agree(mis, bsdf, 4, "MIS vs BSDF");
   expect_agree(nee, bsdf, 4, "NEE vs BSDF");
 }
+
+INSTANTIATE_TEST_SUITE_P(Sky, StrategiesAgree, ::testing::Values(false, true), [](const auto& p) {
+  return std::string(p.param ? "EnvironmentMap" : "ConstantSky");
+});
 
 TEST_F(LightTransport, HeuristicsAndLightSelectionAgree) {
   const wp::Scene s = agreement_scene();
