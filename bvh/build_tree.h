@@ -31,16 +31,15 @@ inline float surface_area(const Box& b) {
   return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
-// What both layouts store of scene triangle `index`: v0, e1 = v1 - v0, e2 = v2 - v0 and its
-// WP_TRI_* flags (0 without BuildInput::triangle_flags).
+// What both layouts store of scene triangle `index`: its vertices, unchanged, and its WP_TRI_*
+// flags (0 without BuildInput::triangle_flags).
 struct StoredTriangle {
-  glm::vec3 v0, e1, e2;
+  glm::vec3 v0, v1, v2;
   std::uint32_t flags;
 };
 inline StoredTriangle stored_triangle(const BuildInput& input, std::uint32_t index) {
   const std::uint32_t* idx = input.indices + 3 * static_cast<std::size_t>(index);
-  const glm::vec3 v0 = input.positions[idx[0]];
-  return StoredTriangle{v0, input.positions[idx[1]] - v0, input.positions[idx[2]] - v0,
+  return StoredTriangle{input.positions[idx[0]], input.positions[idx[1]], input.positions[idx[2]],
                         input.triangle_flags ? input.triangle_flags[index] : 0u};
 }
 

@@ -95,7 +95,7 @@ bool intersect_triangle(const dev::IsectTri& tri, const Ray& ray, float tmax, Hi
 // `spatial_splits`); without spatial splits, each referenced triangle lies inside its leaf's box.
 // Width 2: leaves of 1..WP_BVH_MAX_LEAF_SIZE triangles. Width 8: used slots first, unused slots
 // (child 0, boxes +INFINITY) last; leaves of 1..WP_BVH8_MAX_LEAF_BLOCKS blocks that no two leaves
-// share, with the unused lanes (all-zero v0 and edges, prim 0xffffffff, flags 0) only at the end
+// share, with the unused lanes (all-zero vertices, prim 0xffffffff, flags 0) only at the end
 // of a leaf's last block, which has at least one used lane.
 std::string check_invariants(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits);
 

@@ -101,8 +101,8 @@ class Flattener {
   dev::IsectTri isect_tri(std::uint32_t index) const {
     const detail::StoredTriangle t = detail::stored_triangle(input_, index);
     return dev::IsectTri{dev::float4{t.v0.x, t.v0.y, t.v0.z, uint_bits_as_float(index)},
-                         dev::float4{t.e1.x, t.e1.y, t.e1.z, uint_bits_as_float(t.flags)},
-                         dev::float4{t.e2.x, t.e2.y, t.e2.z, 0.0f}};
+                         dev::float4{t.v1.x, t.v1.y, t.v1.z, uint_bits_as_float(t.flags)},
+                         dev::float4{t.v2.x, t.v2.y, t.v2.z, 0.0f}};
   }
 
   BuildStats& stats() { return out_.stats; }

@@ -12,7 +12,7 @@ namespace wp::bvh {
 namespace {
 
 // Bump when the layout of a cached Bvh or of its arrays changes.
-constexpr std::uint64_t kFormat = 1;
+constexpr std::uint64_t kFormat = 2;  // 2: triangles stored as vertices (watertight test)
 constexpr char kMagic[8] = {'w', 'p', 'b', 'v', 'h', '0', '0', '1'};
 
 // A 64-bit multiply-xorshift hash over words, fed in order; not cryptographic, only collision

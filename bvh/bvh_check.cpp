@@ -104,7 +104,7 @@ class Checker {
       const dev::IsectTri& t = bvh_.triangles[i];
       const std::uint32_t index = bits(t.v0.w);
       if (!refs_.add(index)) return fail(node, slot, "triangle index out of range");
-      if (bits(t.e2.w) != 0) return fail(node, slot, "e2.w not 0");
+      if (bits(t.v2.w) != 0) return fail(node, slot, "v2.w not 0");
       if (!triangle_fits(t, box))
         return fail(node, slot, "triangle " + std::to_string(index) + " outside its leaf box");
     }
@@ -112,9 +112,9 @@ class Checker {
 
   bool triangle_fits(const dev::IsectTri& t, const ChildBox& box) const {
     const float v0[3] = {t.v0.x, t.v0.y, t.v0.z};
-    const float e1[3] = {t.e1.x, t.e1.y, t.e1.z};
-    const float e2[3] = {t.e2.x, t.e2.y, t.e2.z};
-    return detail::triangle_fits(v0, e1, e2, box, splits_, tolerance_);
+    const float v1[3] = {t.v1.x, t.v1.y, t.v1.z};
+    const float v2[3] = {t.v2.x, t.v2.y, t.v2.z};
+    return detail::triangle_fits(v0, v1, v2, box, splits_, tolerance_);
   }
 
   void finish() {

@@ -29,7 +29,7 @@ bool unused_box(const ChildBox& b) {
 
 // One lane of a block, as arrays for the fit test.
 struct Lane {
-  float v0[3], e1[3], e2[3];
+  float v0[3], v1[3], v2[3];
   std::uint32_t prim, flags;
 };
 
@@ -41,17 +41,17 @@ std::uint32_t get(const dev::uint4& v, int i) {
 }
 
 Lane lane(const dev::TriBlock4& b, int i) {
-  return Lane{{get(b.v0x, i), get(b.v0y, i), get(b.v0z, i)},
-              {get(b.e1x, i), get(b.e1y, i), get(b.e1z, i)},
-              {get(b.e2x, i), get(b.e2y, i), get(b.e2z, i)},
+  return Lane{{get(b.v0[0], i), get(b.v0[1], i), get(b.v0[2], i)},
+              {get(b.v1[0], i), get(b.v1[1], i), get(b.v1[2], i)},
+              {get(b.v2[0], i), get(b.v2[1], i), get(b.v2[2], i)},
               get(b.prim, i),
               get(b.flags, i)};
 }
 
-// An unused lane: all-zero vertex and edges (det = 0, never hit), prim 0xffffffff, flags 0.
+// An unused lane: all-zero vertices (zero area, never hit), prim 0xffffffff, flags 0.
 bool unused_lane_is_clear(const Lane& l) {
   for (int k = 0; k < 3; ++k)
-    if (l.v0[k] != 0.0f || l.e1[k] != 0.0f || l.e2[k] != 0.0f) return false;
+    if (l.v0[k] != 0.0f || l.v1[k] != 0.0f || l.v2[k] != 0.0f) return false;
   return l.flags == 0;
 }
 
@@ -151,7 +151,7 @@ class WideChecker {
 
   void used_lane(std::int32_t node, int slot, const Lane& l, const ChildBox& box) {
     if (!refs_.add(l.prim)) return fail(node, slot, "triangle index out of range");
-    if (!triangle_fits(l.v0, l.e1, l.e2, box, splits_, tolerance_))
+    if (!triangle_fits(l.v0, l.v1, l.v2, box, splits_, tolerance_))
       fail(node, slot, "triangle " + std::to_string(l.prim) + " outside its leaf box");
   }
 

@@ -4,8 +4,8 @@
 // Nodes are written in depth-first preorder (a node, then the subtrees of its children in slot
 // order), node 0 the root; a node's children keep Embree's order, unused slots last. A leaf's
 // triangles are packed into ceil(n / 4) consecutive blocks, appended when the leaf is met in that
-// same order; the unused lanes of its last block hold zero vertex and edges, prim 0xffffffff and
-// flags 0.
+// same order; the unused lanes of its last block hold zero vertices, prim 0xffffffff and flags
+// 0.
 #include <algorithm>
 #include <limits>
 #include <memory>
@@ -124,14 +124,13 @@ class WideFlattener {
     Box b{glm::vec3(kInf), glm::vec3(-kInf)};
     for (unsigned i = 0; i < leaf.count; ++i) {
       const StoredTriangle t = stored_triangle(input_, leaf.prims[i]);
-      const glm::vec3 v1 = t.v0 + t.e1, v2 = t.v0 + t.e2;
-      b.lo = glm::min(b.lo, glm::min(t.v0, glm::min(v1, v2)));
-      b.hi = glm::max(b.hi, glm::max(t.v0, glm::max(v1, v2)));
+      b.lo = glm::min(b.lo, glm::min(t.v0, glm::min(t.v1, t.v2)));
+      b.hi = glm::max(b.hi, glm::max(t.v0, glm::max(t.v1, t.v2)));
     }
     b.lo = glm::max(b.lo, clip.lo);
     b.hi = glm::min(b.hi, clip.hi);
-    // Rounding (v0 + e1 is not v1 exactly, clipped pieces are rounded outwards) may leave an
-    // axis empty by an ulp: fall back to the clip box there.
+    // Clipped pieces are rounded outwards, which may leave an axis empty by an ulp: fall back to
+    // the clip box there.
     for (int k = 0; k < 3; ++k)
       if (!(b.lo[k] <= b.hi[k])) b.lo[k] = clip.lo[k], b.hi[k] = clip.hi[k];
     return b;
@@ -160,9 +159,11 @@ class WideFlattener {
 
   void set_triangle(dev::TriBlock4& b, unsigned lane, std::uint32_t index) const {
     const StoredTriangle t = stored_triangle(input_, index);
-    set_lane(b.v0x, lane, t.v0.x), set_lane(b.v0y, lane, t.v0.y), set_lane(b.v0z, lane, t.v0.z);
-    set_lane(b.e1x, lane, t.e1.x), set_lane(b.e1y, lane, t.e1.y), set_lane(b.e1z, lane, t.e1.z);
-    set_lane(b.e2x, lane, t.e2.x), set_lane(b.e2y, lane, t.e2.y), set_lane(b.e2z, lane, t.e2.z);
+    for (int k = 0; k < 3; ++k) {
+      set_lane(b.v0[k], lane, t.v0[k]);
+      set_lane(b.v1[k], lane, t.v1[k]);
+      set_lane(b.v2[k], lane, t.v2[k]);
+    }
     set_lane(b.prim, lane, index);
     set_lane(b.flags, lane, t.flags);
   }

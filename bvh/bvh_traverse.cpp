@@ -24,16 +24,8 @@ float box_entry(const PreparedRay& r, float lox, float hix, float loy, float hiy
 }
 
 detail::TriangleData triangle_data(const dev::IsectTri& t) {
-  return detail::TriangleData{t.v0.x,
-                              t.v0.y,
-                              t.v0.z,
-                              t.e1.x,
-                              t.e1.y,
-                              t.e1.z,
-                              t.e2.x,
-                              t.e2.y,
-                              t.e2.z,
-                              detail::float_bits(t.e1.w),
+  return detail::TriangleData{{{t.v0.x, t.v0.y, t.v0.z}, {t.v1.x, t.v1.y, t.v1.z}, {t.v2.x, t.v2.y, t.v2.z}},
+                              detail::float_bits(t.v1.w),
                               detail::float_bits(t.v0.w)};
 }
 

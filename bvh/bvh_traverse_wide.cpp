@@ -34,13 +34,19 @@ std::uint32_t lane(const dev::uint4& v, int i) {
 }
 
 TriangleData triangle_data(const dev::TriBlock4& b, int i) {
-  return TriangleData{lane(b.v0x, i), lane(b.v0y, i),   lane(b.v0z, i), lane(b.e1x, i),
-                      lane(b.e1y, i), lane(b.e1z, i),   lane(b.e2x, i), lane(b.e2y, i),
-                      lane(b.e2z, i), lane(b.flags, i), lane(b.prim, i)};
+  TriangleData t{};
+  for (int k = 0; k < 3; ++k) {
+    t.v[0][k] = lane(b.v0[k], i);
+    t.v[1][k] = lane(b.v1[k], i);
+    t.v[2][k] = lane(b.v2[k], i);
+  }
+  t.flags = lane(b.flags, i);
+  t.prim = lane(b.prim, i);
+  return t;
 }
 
 // Intersects the leaf `child` (< 0) against (tmin, tmax), lowering tmax at each closer hit; with
-// `any`, stops at the first hit. Unused lanes (zero edges: det = 0) never hit. Returns whether
+// `any`, stops at the first hit. Unused lanes (zero area: det = 0) never hit. Returns whether
 // anything was hit.
 bool leaf_test(const Bvh& bvh, const PreparedRay& r, std::int32_t child, Hit& hit, float& tmax,
                bool any) {

@@ -27,15 +27,15 @@ inline bool inside(const ChildBox& c, const ChildBox& p) {
   return true;
 }
 
-// Whether a stored triangle (v0 and the edges) fits the leaf box `box`: without spatial splits
-// the whole triangle lies in it; with them its bounds must at least overlap it (the box holds a
-// clipped piece). v1 = v0 + e1 is rebuilt with a rounding error of a few ulps of the scene's
-// coordinates, which `tolerance` absorbs.
-inline bool triangle_fits(const float v0[3], const float e1[3], const float e2[3],
+// Whether a stored triangle (its vertices) fits the leaf box `box`: without spatial splits the
+// whole triangle lies in it; with them its bounds must at least overlap it (the box holds a
+// clipped piece, whose bounds are rounded outwards by a few ulps of the scene's coordinates, which
+// `tolerance` absorbs).
+inline bool triangle_fits(const float v0[3], const float v1[3], const float v2[3],
                           const ChildBox& box, bool splits, float tolerance) {
   for (int k = 0; k < 3; ++k) {
-    const float lo = std::min({v0[k], v0[k] + e1[k], v0[k] + e2[k]});
-    const float hi = std::max({v0[k], v0[k] + e1[k], v0[k] + e2[k]});
+    const float lo = std::min({v0[k], v1[k], v2[k]});
+    const float hi = std::max({v0[k], v1[k], v2[k]});
     const bool ok = splits ? hi >= box.lo[k] - tolerance && lo <= box.hi[k] + tolerance
                            : lo >= box.lo[k] - tolerance && hi <= box.hi[k] + tolerance;
     if (!ok) return false;

@@ -9,13 +9,14 @@
 //               tnear = max(max(min(t0x,t1x), min(t0y,t1y)), max(min(t0z,t1z), tmin))
 //               tfar  = min(min(max(t0x,t1x), max(t0y,t1y)), min(max(t0z,t1z), tmax_current))
 //               entered iff tnear <= tfar
-//   triangle    Moller-Trumbore, cross and dot written out component by component (see below);
+//   triangle    the watertight test of Woop, Benthin and Wald (JCGT 2013), see triangle_test();
 //               a hit iff tmin < t < tmax_current, so a later triangle replaces only if closer.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 #include "bvh.h"
 
@@ -31,8 +32,29 @@ inline float safe_rcp(float d) {
   return 1.0f / (std::fabs(d) > 1e-20f ? d : std::copysign(1e-20f, d));
 }
 
+// The ray's frame for the watertight triangle test: kz the axis of |d|'s largest component
+// (the first on ties), kx and ky the two others in cyclic order, swapped when d[kz] < 0 so the
+// triangle's winding, and so its facing, is kept; the shear sx, sy and the scale sz map d to
+// (0, 0, 1).
+struct RayFrame {
+  int kx, ky, kz;
+  float sx, sy, sz;
+  explicit RayFrame(const glm::vec3& d) {
+    const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+    kz = ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0f) std::swap(kx, ky);
+    sx = d[kx] / d[kz];
+    sy = d[ky] / d[kz];
+    sz = 1.0f / d[kz];
+  }
+};
+
 struct PreparedRay {
   float ox, oy, oz, dx, dy, dz, ix, iy, iz, tmin;
+  RayFrame f;
+  float o_kx, o_ky, o_kz;  // the origin in the frame's axes
   explicit PreparedRay(const Ray& r)
       : ox(r.o.x),
         oy(r.o.y),
@@ -43,7 +65,11 @@ struct PreparedRay {
         ix(safe_rcp(r.d.x)),
         iy(safe_rcp(r.d.y)),
         iz(safe_rcp(r.d.z)),
-        tmin(r.tmin) {}
+        tmin(r.tmin),
+        f(r.d),
+        o_kx(r.o[f.kx]),
+        o_ky(r.o[f.ky]),
+        o_kz(r.o[f.kz]) {}
 };
 
 // NaN-free inputs only (the builder rejects non-finite vertices), so these agree with OpenCL's
@@ -67,37 +93,46 @@ inline bool slab_test(const PreparedRay& r, float lox, float hix, float loy, flo
   return tnear <= tfar;
 }
 
-// One stored triangle, whichever layout it comes from.
+// One stored triangle, whichever layout it comes from: v[vertex][axis].
 struct TriangleData {
-  float v0x, v0y, v0z;
-  float e1x, e1y, e1z;
-  float e2x, e2y, e2z;
+  float v[3][3];
   std::uint32_t flags;  // WP_TRI_*
   std::uint32_t prim;   // scene triangle index
 };
 
-// Moller-Trumbore. det > 0 is a front-face hit (cross(e1, e2) faces against d). Returns whether
-// tmin < t < tmax, and then fills `hit`.
+// The watertight ray-triangle test (Woop, Benthin and Wald, JCGT 2(1) 2013). The vertices are
+// moved to the ray's origin and sheared so that the ray runs along +z (RayFrame); the 2D edge
+// functions U, V, W of the edges opposite v0, v1, v2 then say on which side of each edge the ray
+// passes. Two triangles sharing an edge share its vertices bit for bit (the layouts store them
+// unchanged) and compute that edge's function as a*b - c*d and c*d - a*b from the same two
+// rounded products, so one is exactly the negative of the other: no ray passes between them.
+// A hit needs U, V, W of one sign (zeros count for both, so a ray exactly on an edge hits both
+// triangles rather than neither). det = U + V + W > 0 is a front-face hit (cross(v1 - v0,
+// v2 - v0) faces against d); barycentrics u = V / det (of v1), v = W / det (of v2). No fused
+// multiply-adds anywhere (see the top of this file): with them the two products of an edge
+// function round differently and the symmetry is lost. Returns whether tmin < t < tmax, and then
+// fills `hit`.
 inline bool triangle_test(const PreparedRay& r, const TriangleData& tri, float tmax, Hit& hit) {
-  const float px = r.dy * tri.e2z - r.dz * tri.e2y;  // p = cross(d, e2)
-  const float py = r.dz * tri.e2x - r.dx * tri.e2z;
-  const float pz = r.dx * tri.e2y - r.dy * tri.e2x;
-  const float det = tri.e1x * px + tri.e1y * py + tri.e1z * pz;
+  const int kx = r.f.kx, ky = r.f.ky, kz = r.f.kz;
+  const float az = tri.v[0][kz] - r.o_kz, bz = tri.v[1][kz] - r.o_kz, cz = tri.v[2][kz] - r.o_kz;
+  const float ax = (tri.v[0][kx] - r.o_kx) - r.f.sx * az;
+  const float ay = (tri.v[0][ky] - r.o_ky) - r.f.sy * az;
+  const float bx = (tri.v[1][kx] - r.o_kx) - r.f.sx * bz;
+  const float by = (tri.v[1][ky] - r.o_ky) - r.f.sy * bz;
+  const float cx = (tri.v[2][kx] - r.o_kx) - r.f.sx * cz;
+  const float cy = (tri.v[2][ky] - r.o_ky) - r.f.sy * cz;
+  const float u_ = cx * by - cy * bx;
+  const float v_ = ax * cy - ay * cx;
+  const float w_ = bx * ay - by * ax;
+  if ((u_ < 0.0f || v_ < 0.0f || w_ < 0.0f) && (u_ > 0.0f || v_ > 0.0f || w_ > 0.0f)) return false;
+  const float det = u_ + v_ + w_;
   if (det == 0.0f) return false;
   if ((tri.flags & WP_TRI_CULL_BACKFACE) && det < 0.0f) return false;
   const float inv = 1.0f / det;
-  const float sx = r.ox - tri.v0x, sy = r.oy - tri.v0y, sz = r.oz - tri.v0z;  // s = o - v0
-  const float u = (sx * px + sy * py + sz * pz) * inv;
-  if (u < 0.0f || u > 1.0f) return false;
-  const float qx = sy * tri.e1z - sz * tri.e1y;  // q = cross(s, e1)
-  const float qy = sz * tri.e1x - sx * tri.e1z;
-  const float qz = sx * tri.e1y - sy * tri.e1x;
-  const float v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv;
-  if (v < 0.0f || u + v > 1.0f) return false;
-  const float t = (tri.e2x * qx + tri.e2y * qy + tri.e2z * qz) * inv;
+  const float t = (u_ * (r.f.sz * az) + v_ * (r.f.sz * bz) + w_ * (r.f.sz * cz)) * inv;
   if (!(t > r.tmin && t < tmax)) return false;
   hit.hit = true;
-  hit.t = t, hit.u = u, hit.v = v;
+  hit.t = t, hit.u = v_ * inv, hit.v = w_ * inv;
   hit.triangle = tri.prim;
   return true;
 }

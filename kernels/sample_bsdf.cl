@@ -23,6 +23,6 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   paths.info[slot].z = bs.delta ? WP_PATH_DELTA : 0u;
   /* Leave on the side the new direction goes to (below for transmission). */
   paths.ray_o[slot] =
-      (float4)(offset_origin(s.p, dot(bs.wi, s.ng) > 0.0f ? s.ng : -s.ng, s.p_scale), 0.0f);
+      (float4)(surface_spawn(&s, paths.ray_d[slot].xyz, paths.hit[slot].x, bs.wi), 0.0f);
   paths.ray_d[slot] = (float4)(bs.wi, INFINITY);
 }

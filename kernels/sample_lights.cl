@@ -27,7 +27,7 @@ __kernel void sample_lights(WP_STAGE_PARAMS) {
   /* The shadow ray leaves the side of the surface the light is on (transmission can light the
    * back) and, for a light at a finite distance, runs from the moved origin to the light's target
    * point (itself moved off an area light's surface): neither end can hit the surface it is on. */
-  const float3 o = offset_origin(s.p, dot(s.ng, ls.wi) > 0.0f ? s.ng : -s.ng, s.p_scale);
+  const float3 o = surface_spawn(&s, paths.ray_d[slot].xyz, paths.hit[slot].x, ls.wi);
   float3 dir = ls.wi;
   float tmax = INFINITY;
   if (ls.dist < INFINITY) {

@@ -31,4 +31,20 @@ inline Surface surface_load(Paths paths, uint slot) {
   return s;
 }
 
+/* The origin of a ray leaving surface s in direction wi (a BSDF sample or a shadow ray), for a
+ * path that arrived along unit d_in after travelling t_in. It is moved off s along the geometric
+ * normal, to the side wi goes to (offset_origin). On the side the path came from, it is also pulled
+ * back along d_in by as much (at most half the way to the previous vertex, which was free space):
+ * a hit in a concave corner lies, within rounding, on the neighbouring surface too, and moving
+ * along s's normal alone leaves it there; a ray from there into the neighbour starts on its plane,
+ * finds t = 0 (or -1e-8) and passes through it, leaking light into closed rooms
+ * (scenes/failure/closed_box). The pulled-back point is on the path's free side of every surface
+ * the path did not cross. A refracted ray leaves on the far side, where there is no such point. */
+inline float3 surface_spawn(const Surface* s, float3 d_in, float t_in, float3 wi) {
+  const float shift = s->p_scale * (1.0f / 65536.0f);
+  if (dot(wi, s->ng) > 0.0f) /* ng faces the incoming ray */
+    return offset_origin(s->p - d_in * fmin(shift, 0.5f * t_in), s->ng, s->p_scale);
+  return offset_origin(s->p, -s->ng, s->p_scale);
+}
+
 #endif /* WP_SURFACE_H */

@@ -2,9 +2,9 @@
  * layout is here; with -D WP_BVH_WIDTH=8 the wide one (traverse8.h) replaces it.
  *
  * The arithmetic is exactly that of the CPU reference (bvh/bvh_traverse.cpp), which the tests
- * compare against Embree: slab test with clamped reciprocal directions, Moller-Trumbore written
- * in scalar operations (on PoCL the float3 cross/dot builtins vectorise worse), nearer child
- * first, leaves intersected as soon as they are reached.
+ * compare against Embree: slab test with clamped reciprocal directions, the watertight triangle
+ * test (bvh/traverse_common.h explains it) written in scalar operations (on PoCL the float3
+ * builtins vectorise worse), nearer child first, leaves intersected as soon as they are reached.
  */
 #ifndef WP_TRAVERSE_H
 #define WP_TRAVERSE_H
@@ -14,7 +14,8 @@
 
 /* No fused multiply-adds here: the CPU reference is written without them, and with contraction
  * the kernel's results differ from it in the last bits (and, measured on PoCL, some rays missed a
- * triangle the reference and Embree both hit). Exact agreement makes the kernel testable. */
+ * triangle the reference and Embree both hit). Exact agreement makes the kernel testable, and the
+ * watertight test needs each edge function's two products rounded alike. */
 #pragma OPENCL FP_CONTRACT OFF
 
 typedef struct TraceRay {
@@ -23,6 +24,11 @@ typedef struct TraceRay {
   float ix, iy, iz; /* clamped reciprocal direction */
   float tmin;
   uint alpha_key; /* identifies the ray's path and bounce for stochastic alpha (alpha.h) */
+  /* The watertight test's frame (bvh/traverse_common.h, RayFrame): axes kx, ky, kz, shear
+   * sx, sy and scale sz, and the origin in those axes. */
+  int kx, ky, kz;
+  float sx, sy, sz;
+  float o_kx, o_ky, o_kz;
 } TraceRay;
 
 typedef struct TraceHit {
@@ -41,6 +47,21 @@ inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key) {
   r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
   r.tmin = tmin;
   r.alpha_key = alpha_key;
+  const float ax = fabs(d.x), ay = fabs(d.y), az = fabs(d.z);
+  const int kz = ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1;
+  int ky = kx == 2 ? 0 : kx + 1;
+  const float o3[3] = {o.x, o.y, o.z}, d3[3] = {d.x, d.y, d.z};
+  if (d3[kz] < 0.0f) {
+    const int k = kx;
+    kx = ky;
+    ky = k;
+  }
+  r.kx = kx, r.ky = ky, r.kz = kz;
+  r.sx = d3[kx] / d3[kz];
+  r.sy = d3[ky] / d3[kz];
+  r.sz = 1.0f / d3[kz];
+  r.o_kx = o3[kx], r.o_ky = o3[ky], r.o_kz = o3[kz];
   return r;
 }
 
@@ -56,34 +77,38 @@ inline float box_entry(const TraceRay* r, float lox, float hix, float loy, float
   return tnear <= tfar ? tnear : INFINITY;
 }
 
-/* Moller-Trumbore against one stored triangle. On a hit closer than hit->t, updates *hit. */
+/* The watertight test against one stored triangle. On a hit closer than hit->t, updates *hit. */
 inline bool triangle_test(const SceneView* scene, const TraceRay* r, __global const IsectTri* tri,
                           TraceHit* hit) {
-  const float4 v0 = tri->v0, e1 = tri->e1, e2 = tri->e2;
-  const float px = r->dy * e2.z - r->dz * e2.y;
-  const float py = r->dz * e2.x - r->dx * e2.z;
-  const float pz = r->dx * e2.y - r->dy * e2.x;
-  const float det = e1.x * px + e1.y * py + e1.z * pz;
+  __global const float* v0 = (__global const float*)&tri->v0;
+  __global const float* v1 = (__global const float*)&tri->v1;
+  __global const float* v2 = (__global const float*)&tri->v2;
+  const float az = v0[r->kz] - r->o_kz, bz = v1[r->kz] - r->o_kz, cz = v2[r->kz] - r->o_kz;
+  const float ax = (v0[r->kx] - r->o_kx) - r->sx * az;
+  const float ay = (v0[r->ky] - r->o_ky) - r->sy * az;
+  const float bx = (v1[r->kx] - r->o_kx) - r->sx * bz;
+  const float by = (v1[r->ky] - r->o_ky) - r->sy * bz;
+  const float cx = (v2[r->kx] - r->o_kx) - r->sx * cz;
+  const float cy = (v2[r->ky] - r->o_ky) - r->sy * cz;
+  const float u_ = cx * by - cy * bx;
+  const float v_ = ax * cy - ay * cx;
+  const float w_ = bx * ay - by * ax;
+  if ((u_ < 0.0f || v_ < 0.0f || w_ < 0.0f) && (u_ > 0.0f || v_ > 0.0f || w_ > 0.0f)) return false;
+  const float det = u_ + v_ + w_;
   if (det == 0.0f) return false;
-  if ((as_uint(e1.w) & WP_TRI_CULL_BACKFACE) && det < 0.0f) return false;
+  const uint flags = as_uint(tri->v1.w);
+  if ((flags & WP_TRI_CULL_BACKFACE) && det < 0.0f) return false;
   const float inv = 1.0f / det;
-  const float sx = r->ox - v0.x, sy = r->oy - v0.y, sz = r->oz - v0.z;
-  const float u = (sx * px + sy * py + sz * pz) * inv;
-  if (u < 0.0f || u > 1.0f) return false;
-  const float qx = sy * e1.z - sz * e1.y;
-  const float qy = sz * e1.x - sx * e1.z;
-  const float qz = sx * e1.y - sy * e1.x;
-  const float v = (r->dx * qx + r->dy * qy + r->dz * qz) * inv;
-  if (v < 0.0f || u + v > 1.0f) return false;
-  const float t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv;
+  const float t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;
   if (!(t > r->tmin && t < hit->t)) return false;
+  const float u = v_ * inv, v = w_ * inv;
+  const uint prim = as_uint(tri->v0.w);
 #if WP_FEATURE_ALPHA
-  if ((as_uint(e1.w) & WP_TRI_ALPHA) && !alpha_passes(scene, as_uint(v0.w), u, v, r->alpha_key))
-    return false;
+  if ((flags & WP_TRI_ALPHA) && !alpha_passes(scene, prim, u, v, r->alpha_key)) return false;
 #else
   (void)scene;
 #endif
-  hit->t = t, hit->u = u, hit->v = v, hit->tri = as_uint(v0.w);
+  hit->t = t, hit->u = u, hit->v = v, hit->tri = prim;
   return true;
 }
 

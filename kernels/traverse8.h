@@ -10,27 +10,29 @@
 #ifndef WP_TRAVERSE8_H
 #define WP_TRAVERSE8_H
 
-/* Moller-Trumbore on the 4 lanes of a block; updates *hit with the closest lane that is closer. */
+/* The watertight test (bvh/traverse_common.h) on the 4 lanes of a block; updates *hit with the
+ * closest lane that is closer. */
 inline bool block_test(const SceneView* scene, const TraceRay* r, __global const TriBlock4* b,
                        TraceHit* hit) {
-  const float4 e1x = b->e1x, e1y = b->e1y, e1z = b->e1z;
-  const float4 e2x = b->e2x, e2y = b->e2y, e2z = b->e2z;
-  const float4 px = r->dy * e2z - r->dz * e2y;
-  const float4 py = r->dz * e2x - r->dx * e2z;
-  const float4 pz = r->dx * e2y - r->dy * e2x;
-  const float4 det = e1x * px + e1y * py + e1z * pz;
+  const float4 az = b->v0[r->kz] - r->o_kz, bz = b->v1[r->kz] - r->o_kz,
+               cz = b->v2[r->kz] - r->o_kz;
+  const float4 ax = (b->v0[r->kx] - r->o_kx) - r->sx * az;
+  const float4 ay = (b->v0[r->ky] - r->o_ky) - r->sy * az;
+  const float4 bx = (b->v1[r->kx] - r->o_kx) - r->sx * bz;
+  const float4 by = (b->v1[r->ky] - r->o_ky) - r->sy * bz;
+  const float4 cx = (b->v2[r->kx] - r->o_kx) - r->sx * cz;
+  const float4 cy = (b->v2[r->ky] - r->o_ky) - r->sy * cz;
+  const float4 u_ = cx * by - cy * bx;
+  const float4 v_ = ax * cy - ay * cx;
+  const float4 w_ = bx * ay - by * ax;
+  const int4 mixed = ((u_ < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f)) & ((u_ > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f));
+  const float4 det = u_ + v_ + w_;
   const float4 inv = 1.0f / det;
-  const float4 sx = r->ox - b->v0x, sy = r->oy - b->v0y, sz = r->oz - b->v0z;
-  const float4 u = (sx * px + sy * py + sz * pz) * inv;
-  const float4 qx = sy * e1z - sz * e1y;
-  const float4 qy = sz * e1x - sx * e1z;
-  const float4 qz = sx * e1y - sy * e1x;
-  const float4 v = (r->dx * qx + r->dy * qy + r->dz * qz) * inv;
-  const float4 t = (e2x * qx + e2y * qy + e2z * qz) * inv;
+  const float4 t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;
+  const float4 u = v_ * inv, v = w_ * inv;
   const uint4 flags = b->flags;
   const int4 cull = ((flags & WP_TRI_CULL_BACKFACE) != 0) & (det < 0.0f);
-  int4 ok = (det != 0.0f) & ~cull & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) & (u + v <= 1.0f) &
-            (t > r->tmin);
+  int4 ok = ~mixed & (det != 0.0f) & ~cull & (t > r->tmin);
   if (!any(ok)) return false;
   /* Lanes in order, strictly closer replaces: the reference's rule. */
   float tl[4], ul[4], vl[4];

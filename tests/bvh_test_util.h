@@ -185,18 +185,18 @@ inline float scene_size(const Bvh& bvh) {
   return glm::length(bvh.hi - bvh.lo);
 }
 
-// Each scene triangle as both layouts store it (v0, edges, flags; v0.w its index): what the
+// Each scene triangle as both layouts store it (vertices, flags; v0.w its index): what the
 // comparison and the brute-force loops test.
 inline std::vector<dev::IsectTri> stored_triangles(const Mesh& m) {
   std::vector<dev::IsectTri> out;
   for (std::size_t i = 0; i < m.triangles(); ++i) {
     const glm::vec3 v0 = m.positions[m.indices[3 * i]];
-    const glm::vec3 e1 = m.positions[m.indices[3 * i + 1]] - v0;
-    const glm::vec3 e2 = m.positions[m.indices[3 * i + 2]] - v0;
+    const glm::vec3 v1 = m.positions[m.indices[3 * i + 1]];
+    const glm::vec3 v2 = m.positions[m.indices[3 * i + 2]];
     const std::uint32_t flags = m.flags.empty() ? 0u : m.flags[i];
     out.push_back({{v0.x, v0.y, v0.z, as_float(std::uint32_t(i))},
-                   {e1.x, e1.y, e1.z, as_float(flags)},
-                   {e2.x, e2.y, e2.z, 0.0f}});
+                   {v1.x, v1.y, v1.z, as_float(flags)},
+                   {v2.x, v2.y, v2.z, 0.0f}});
   }
   return out;
 }
@@ -295,8 +295,8 @@ class Comparison {
   bool near_edge(const Ray& ray, const Hit& h) const {
     const dev::IsectTri& t = tris_[h.triangle];
     const glm::vec3 v0(t.v0.x, t.v0.y, t.v0.z);
-    const glm::vec3 v1 = v0 + glm::vec3(t.e1.x, t.e1.y, t.e1.z);
-    const glm::vec3 v2 = v0 + glm::vec3(t.e2.x, t.e2.y, t.e2.z);
+    const glm::vec3 v1(t.v1.x, t.v1.y, t.v1.z);
+    const glm::vec3 v2(t.v2.x, t.v2.y, t.v2.z);
     const glm::vec3 p = ray.o + h.t * ray.d;
     return std::min({distance_to_segment(p, v0, v1), distance_to_segment(p, v1, v2),
                      distance_to_segment(p, v2, v0)}) < edge_eps_;
@@ -305,8 +305,9 @@ class Comparison {
   // along the ray: that dominates for hits close to the origin and at grazing angles.
   float t_tolerance(const Ray& ray, const Hit& h) const {
     const dev::IsectTri& t = tris_[h.triangle];
-    const glm::vec3 n =
-        glm::cross(glm::vec3(t.e1.x, t.e1.y, t.e1.z), glm::vec3(t.e2.x, t.e2.y, t.e2.z));
+    const glm::vec3 v0(t.v0.x, t.v0.y, t.v0.z);
+    const glm::vec3 n = glm::cross(glm::vec3(t.v1.x, t.v1.y, t.v1.z) - v0,
+                                   glm::vec3(t.v2.x, t.v2.y, t.v2.z) - v0);
     const float cos = std::fabs(glm::dot(n, ray.d)) / (glm::length(n) * glm::length(ray.d));
     return 1e-4f * h.t + 1e-6f * size_ / std::max(cos, 1e-3f);
   }

@@ -122,18 +122,19 @@ TEST(Bvh8Build, SingleTriangleIsARootWithOneLeafAndSevenUnusedSlots) {
   const dev::TriBlock4& b = bvh.blocks[0];
   EXPECT_EQ(b.prim.x, 0u);
   EXPECT_EQ(b.flags.x, WP_TRI_CULL_BACKFACE);
-  EXPECT_EQ(b.e1x.x, 1.0f);
-  EXPECT_EQ(b.e2z.x, 0.5f);
+  EXPECT_EQ(b.v1[0].x, 1.0f);
+  EXPECT_EQ(b.v2[2].x, 0.5f);
   for (const std::uint32_t p : {b.prim.y, b.prim.z, b.prim.w}) EXPECT_EQ(p, 0xffffffffu);
-  for (const dev::float4& v : {b.v0x, b.v0y, b.v0z, b.e1x, b.e1y, b.e1z, b.e2x, b.e2y, b.e2z})
-    EXPECT_TRUE(v.y == 0 && v.z == 0 && v.w == 0);
+  for (int k = 0; k < 3; ++k)
+    for (const dev::float4& v : {b.v0[k], b.v1[k], b.v2[k]})
+      EXPECT_TRUE(v.y == 0 && v.z == 0 && v.w == 0);
   EXPECT_TRUE(b.flags.y == 0 && b.flags.z == 0 && b.flags.w == 0);
   EXPECT_EQ(bvh.stats.max_depth, 1);
   EXPECT_EQ(bvh.stats.leaves, 1u);
   EXPECT_DOUBLE_EQ(bvh.stats.sah_cost, 2.0);  // the root, plus one block over the whole scene
 }
 
-TEST(Bvh8Build, BlockLanesAreVertexAndEdgesWithIndexAndFlags) {
+TEST(Bvh8Build, BlockLanesAreTheVerticesWithIndexAndFlags) {
   Mesh m = sphere(16, 32);
   for (std::size_t i = 0; i < m.triangles(); ++i) m.flags.push_back(std::uint32_t(i % 3 == 0));
   const std::vector<dev::IsectTri> stored = stored_triangles(m);
@@ -156,9 +157,9 @@ TEST(Bvh8Build, BlockLanesAreVertexAndEdgesWithIndexAndFlags) {
       ++used;
       ASSERT_LT(prim, m.triangles());
       const dev::IsectTri& t = stored[prim];
-      EXPECT_EQ(glm::vec3(get(b.v0x), get(b.v0y), get(b.v0z)), glm::vec3(t.v0.x, t.v0.y, t.v0.z));
-      EXPECT_EQ(glm::vec3(get(b.e1x), get(b.e1y), get(b.e1z)), glm::vec3(t.e1.x, t.e1.y, t.e1.z));
-      EXPECT_EQ(glm::vec3(get(b.e2x), get(b.e2y), get(b.e2z)), glm::vec3(t.e2.x, t.e2.y, t.e2.z));
+      EXPECT_EQ(glm::vec3(get(b.v0[0]), get(b.v0[1]), get(b.v0[2])), glm::vec3(t.v0.x, t.v0.y, t.v0.z));
+      EXPECT_EQ(glm::vec3(get(b.v1[0]), get(b.v1[1]), get(b.v1[2])), glm::vec3(t.v1.x, t.v1.y, t.v1.z));
+      EXPECT_EQ(glm::vec3(get(b.v2[0]), get(b.v2[1]), get(b.v2[2])), glm::vec3(t.v2.x, t.v2.y, t.v2.z));
       EXPECT_EQ(flags, m.flags[prim]);
     }
   EXPECT_EQ(used, m.triangles());

@@ -8,11 +8,14 @@
  * An empty child (only in a root whose scene is a single leaf) is a leaf with count 0: rays may
  * enter its (inverted, lo > hi) box, but it holds no triangle to test.
  *
- * Triangles are reordered so that every leaf's triangles are contiguous. Each is stored ready for
- * the Moller-Trumbore test: v0, e1 = v1 - v0, e2 = v2 - v0, world space. The spare w lanes carry
+ * Triangles are reordered so that every leaf's triangles are contiguous. Each is stored as its
+ * three world-space vertices, exactly as the scene gives them, for the watertight test: triangles
+ * sharing an edge then share its vertices bit for bit, and the test evaluates the edge the same way
+ * for both (traverse_common.h). The spare w lanes carry
  *   v0.w : the index of the triangle in the scene (as_float of a uint),
- *   e1.w : WP_TRI_* flags (as_float of a uint).
- * The front face is counter-clockwise (glTF): the geometric normal cross(e1, e2) points to it.
+ *   v1.w : WP_TRI_* flags (as_float of a uint).
+ * The front face is counter-clockwise (glTF): the geometric normal cross(v1 - v0, v2 - v0) points
+ * to it.
  */
 #ifndef WP_SHARED_BVH_LAYOUT_H
 #define WP_SHARED_BVH_LAYOUT_H
@@ -27,7 +30,7 @@
 /* Largest leaf the builder makes; the link.z/link.w counts never exceed it. */
 #define WP_BVH_MAX_LEAF_SIZE 8
 
-/* Triangle flags (IsectTri.e1.w). */
+/* Triangle flags (IsectTri.v1.w). */
 #define WP_TRI_CULL_BACKFACE 1u /* single-sided material: back faces are not there for any ray */
 #define WP_TRI_ALPHA 2u         /* alphaMode MASK or BLEND: a hit counts only if alpha_passes() */
 
@@ -61,21 +64,21 @@ typedef struct BvhNode8 {
   int8 child;
 } BvhNode8;
 
-/* Four triangles, lane by lane: v0, e1 = v1 - v0, e2 = v2 - v0 (as in IsectTri), the scene
- * triangle index and WP_TRI_* flags. Unused lanes have zero edges (det = 0: never hit) and
- * prim 0xffffffff. */
+/* Four triangles, lane by lane: the vertices (as in IsectTri), each as 3 axes (x, y, z) so the
+ * watertight test can pick the axes by the ray's direction, the scene triangle index and WP_TRI_*
+ * flags. Unused lanes have all vertices 0 (zero area: never hit) and prim 0xffffffff. */
 typedef struct TriBlock4 {
-  float4 v0x, v0y, v0z;
-  float4 e1x, e1y, e1z;
-  float4 e2x, e2y, e2z;
+  float4 v0[3];
+  float4 v1[3];
+  float4 v2[3];
   uint4 prim;
   uint4 flags;
 } TriBlock4;
 
 typedef struct IsectTri {
   float4 v0; /* xyz: vertex 0; w: scene triangle index (bits of a uint) */
-  float4 e1; /* xyz: v1 - v0;  w: WP_TRI_* flags (bits of a uint) */
-  float4 e2; /* xyz: v2 - v0;  w: unused (0) */
+  float4 v1; /* xyz: vertex 1; w: WP_TRI_* flags (bits of a uint) */
+  float4 v2; /* xyz: vertex 2; w: unused (0) */
 } IsectTri;
 
 WP_DEV_END
