@@ -24,9 +24,10 @@ float box_entry(const PreparedRay& r, float lox, float hix, float loy, float hiy
 }
 
 detail::TriangleData triangle_data(const dev::IsectTri& t) {
-  return detail::TriangleData{{{t.v0.x, t.v0.y, t.v0.z}, {t.v1.x, t.v1.y, t.v1.z}, {t.v2.x, t.v2.y, t.v2.z}},
-                              detail::float_bits(t.v1.w),
-                              detail::float_bits(t.v0.w)};
+  return detail::TriangleData{
+      {{t.v0.x, t.v0.y, t.v0.z}, {t.v1.x, t.v1.y, t.v1.z}, {t.v2.x, t.v2.y, t.v2.z}},
+      detail::float_bits(t.v1.w),
+      detail::float_bits(t.v0.w)};
 }
 
 // Intersects leaf reference `ref` (count triangles) against (tmin, hit.t); with `any`, stops at

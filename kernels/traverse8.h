@@ -25,7 +25,8 @@ inline bool block_test(const SceneView* scene, const TraceRay* r, __global const
   const float4 u_ = cx * by - cy * bx;
   const float4 v_ = ax * cy - ay * cx;
   const float4 w_ = bx * ay - by * ax;
-  const int4 mixed = ((u_ < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f)) & ((u_ > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f));
+  const int4 mixed =
+      ((u_ < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f)) & ((u_ > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f));
   const float4 det = u_ + v_ + w_;
   const float4 inv = 1.0f / det;
   const float4 t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;

@@ -218,11 +218,18 @@ class GltfBuilder:
 
     def material(self, name, base_color=(1.0, 1.0, 1.0), metallic=0.0, roughness=1.0,
                  emission=(0.0, 0.0, 0.0), emissive_strength=None, double_sided=False,
-                 ior=None, transmission=None):
+                 ior=None, transmission=None, specular=None, thickness=None,
+                 attenuation=None, unlit=False):
         """A metallic-roughness material. emission is the emitted radiance's colour; when a
         component exceeds 1 it is normalised into emissiveFactor and its maximum moves into
         KHR_materials_emissive_strength. emissive_strength, if given, multiplies on top, so the
-        radiance is always emission x (emissive_strength or 1)."""
+        radiance is always emission x (emissive_strength or 1).
+
+        Extensions, each written only when its argument is given: ior (KHR_materials_ior),
+        transmission (KHR_materials_transmission factor), specular (KHR_materials_specular
+        specularFactor; 0 leaves a pure Lambertian dielectric), thickness and attenuation
+        (KHR_materials_volume: thicknessFactor > 0 makes transmission refract; attenuation is
+        (colour, distance)), unlit (KHR_materials_unlit)."""
         color = [float(c) for c in base_color]
         if len(color) == 3:
             color.append(1.0)
@@ -249,6 +256,17 @@ class GltfBuilder:
             ext["KHR_materials_ior"] = {"ior": _clean(ior)}
         if transmission is not None:
             ext["KHR_materials_transmission"] = {"transmissionFactor": _clean(transmission)}
+        if specular is not None:
+            ext["KHR_materials_specular"] = {"specularFactor": _clean(specular)}
+        if thickness is not None or attenuation is not None:
+            volume = {"thicknessFactor": _clean(1.0 if thickness is None else thickness)}
+            if attenuation is not None:
+                colour, distance = attenuation
+                volume["attenuationColor"] = [_clean(c) for c in colour]
+                volume["attenuationDistance"] = _clean(distance)
+            ext["KHR_materials_volume"] = volume
+        if unlit:
+            ext["KHR_materials_unlit"] = {}
         if double_sided:
             m["doubleSided"] = True
         if ext:

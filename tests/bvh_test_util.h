@@ -306,8 +306,8 @@ class Comparison {
   float t_tolerance(const Ray& ray, const Hit& h) const {
     const dev::IsectTri& t = tris_[h.triangle];
     const glm::vec3 v0(t.v0.x, t.v0.y, t.v0.z);
-    const glm::vec3 n = glm::cross(glm::vec3(t.v1.x, t.v1.y, t.v1.z) - v0,
-                                   glm::vec3(t.v2.x, t.v2.y, t.v2.z) - v0);
+    const glm::vec3 n =
+        glm::cross(glm::vec3(t.v1.x, t.v1.y, t.v1.z) - v0, glm::vec3(t.v2.x, t.v2.y, t.v2.z) - v0);
     const float cos = std::fabs(glm::dot(n, ray.d)) / (glm::length(n) * glm::length(ray.d));
     return 1e-4f * h.t + 1e-6f * size_ / std::max(cos, 1e-3f);
   }

@@ -157,9 +157,12 @@ TEST(Bvh8Build, BlockLanesAreTheVerticesWithIndexAndFlags) {
       ++used;
       ASSERT_LT(prim, m.triangles());
       const dev::IsectTri& t = stored[prim];
-      EXPECT_EQ(glm::vec3(get(b.v0[0]), get(b.v0[1]), get(b.v0[2])), glm::vec3(t.v0.x, t.v0.y, t.v0.z));
-      EXPECT_EQ(glm::vec3(get(b.v1[0]), get(b.v1[1]), get(b.v1[2])), glm::vec3(t.v1.x, t.v1.y, t.v1.z));
-      EXPECT_EQ(glm::vec3(get(b.v2[0]), get(b.v2[1]), get(b.v2[2])), glm::vec3(t.v2.x, t.v2.y, t.v2.z));
+      EXPECT_EQ(glm::vec3(get(b.v0[0]), get(b.v0[1]), get(b.v0[2])),
+                glm::vec3(t.v0.x, t.v0.y, t.v0.z));
+      EXPECT_EQ(glm::vec3(get(b.v1[0]), get(b.v1[1]), get(b.v1[2])),
+                glm::vec3(t.v1.x, t.v1.y, t.v1.z));
+      EXPECT_EQ(glm::vec3(get(b.v2[0]), get(b.v2[1]), get(b.v2[2])),
+                glm::vec3(t.v2.x, t.v2.y, t.v2.z));
       EXPECT_EQ(flags, m.flags[prim]);
     }
   EXPECT_EQ(used, m.triangles());

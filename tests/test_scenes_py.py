@@ -3,9 +3,12 @@
 
     python3 tests/test_scenes_py.py
 
-Checks that the committed Cornell box files are exactly what the script writes, that everything
-the builder writes (.gltf and .glb) reads back as structurally valid glTF 2.0, and the Cornell
-box's geometry: every wall/floor/ceiling/light triangle faces into the box, every block triangle
+Checks that the committed Cornell box and failure-mode scene files (scenes/failure/: glTF, the
+environment map env_sun.hdr and manifest.json) are exactly what their scripts write, that
+everything the builder writes (.gltf and .glb) reads back as structurally valid glTF 2.0, the
+failure scenes' stated properties (equal-power Veach lights, the sun where the map convention puts
+it, degenerate triangles present, closed-form models matching the files, scaled copies), and the
+Cornell box's geometry: every wall/floor/ceiling/light triangle faces into the box, every block triangle
 faces out of its block, the light faces down, the camera looks into the open side. If pygltflib
 happens to be installed the files are also loaded with it; otherwise that test is skipped.
 """
@@ -26,6 +29,8 @@ sys.path.insert(0, SCENES)
 
 import gltf_builder as gb  # noqa: E402
 import make_cornell_box as mcb  # noqa: E402
+import make_failure_scenes as mfs  # noqa: E402
+import rgbe  # noqa: E402
 
 COMPONENT_SIZE = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
 COMPONENT_FMT = {5120: "b", 5121: "B", 5122: "h", 5123: "H", 5125: "I", 5126: "f"}
@@ -541,6 +546,220 @@ class BuilderTest(StructureMixin, unittest.TestCase):
             b.mesh("bad", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [0, 1], m)
         with self.assertRaises(ValueError):
             b.node("bad", translation=(1, 0, 0), matrix=[1] * 16)
+
+
+# ---- The failure-mode scenes (scenes/make_failure_scenes.py) ---------------------------------
+
+FAILURE = os.path.join(SCENES, "failure")
+
+
+def failure_files():
+    with open(os.path.join(FAILURE, "manifest.json")) as f:
+        manifest = json.load(f)
+    return manifest, [e["file"] for e in manifest["scenes"]] + ["env_sun.hdr", "manifest.json"]
+
+
+def mesh_positions(doc, binary, name):
+    prim = doc["meshes"][mesh_by_name(doc, name)]["primitives"][0]
+    pos = read_accessor(doc, binary, prim["attributes"]["POSITION"])
+    idx = [i[0] for i in read_accessor(doc, binary, prim["indices"])]
+    return [tuple(pos[i] for i in idx[k:k + 3]) for k in range(0, len(idx), 3)]
+
+
+def tri_area(t):
+    c = cross(sub(t[1], t[0]), sub(t[2], t[0]))
+    return 0.5 * math.sqrt(dot(c, c))
+
+
+def emission_of(doc, name):
+    prim = doc["meshes"][mesh_by_name(doc, name)]["primitives"][0]
+    mat = doc["materials"][prim["material"]]
+    strength = mat.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get(
+        "emissiveStrength", 1.0)
+    return [c * strength for c in mat.get("emissiveFactor", [0.0, 0.0, 0.0])]
+
+
+class FailureScenesTest(StructureMixin, unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        cls.manifest, cls.files = failure_files()
+        cls.docs = {e["name"]: load(os.path.join(FAILURE, e["file"])) for e in cls.manifest["scenes"]}
+
+    def test_regenerates_byte_identically(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            subprocess.run([sys.executable, os.path.join(SCENES, "make_failure_scenes.py"), tmp],
+                           check=True, stdout=subprocess.DEVNULL)
+            self.assertEqual(sorted(os.listdir(tmp)), sorted(self.files))
+            self.assertEqual(sorted(os.listdir(FAILURE)), sorted(self.files), "stray files")
+            for name in self.files:
+                with open(os.path.join(tmp, name), "rb") as f:
+                    fresh = f.read()
+                with open(os.path.join(FAILURE, name), "rb") as f:
+                    committed = f.read()
+                self.assertEqual(fresh, committed, "%s differs from what the script writes: run "
+                                 "python3 scenes/make_failure_scenes.py" % name)
+
+    def test_structure(self):
+        for name, (doc, binary) in self.docs.items():
+            with self.subTest(scene=name):
+                self.check_structure(doc, binary)
+                self.assertTrue(doc.get("cameras"), "no camera")
+
+    def test_manifest(self):
+        names = [e["name"] for e in self.manifest["scenes"]]
+        self.assertEqual(len(names), len(set(names)))
+        for e in self.manifest["scenes"]:
+            self.assertIn(e["reference"]["kind"], ("render", "closed_form", "black", "scene"))
+            if e["reference"]["kind"] == "scene":
+                self.assertIn(e["reference"]["scene"], names)
+            x, y, w, h = e["crop"]
+            self.assertTrue(0 <= x and 0 <= y and w > 0 and h > 0 and x + w <= 128 and y + h <= 96)
+            self.assertTrue(e["breaks"])
+            for i, a in enumerate(e["args"]):
+                if i > 0 and e["args"][i - 1] == "--env":
+                    self.assertTrue(os.path.isfile(os.path.join(FAILURE, a)))
+
+    def test_veach_lights_have_equal_power(self):
+        doc, binary = self.docs["veach_mis"]
+        powers = []
+        for i in range(4):
+            name = "light%d" % i
+            area = sum(tri_area(t) for t in mesh_positions(doc, binary, name))
+            powers.append(math.pi * area * sum(emission_of(doc, name)) / 3.0)
+        for p in powers:  # equal up to the tessellation's area (the same 10 x 20 grid for all)
+            self.assertAlmostEqual(p / powers[0], 1.0, delta=1e-4)
+        radii = [max(abs(v[0] - sum(t[0] for t in tri) / 3) for tri in mesh_positions(doc, binary, "light%d" % i)
+                     for v in tri) for i in range(4)]
+        self.assertEqual(radii, sorted(radii), "emitters not in increasing size")
+
+    def test_closed_form_models_match_the_files(self):
+        doc, binary = self.docs["lambert_quad"]
+        model = self.manifest["scenes"][[e["name"] for e in self.manifest["scenes"]].index(
+            "lambert_quad")]["reference"]["model"]
+        for q, name in zip(model["quads"], ("big", "small")):
+            corners = {tuple(f32(c) for c in v) for v in q["corners"]}
+            got = {v for t in mesh_positions(doc, binary, name) for v in t}
+            self.assertEqual(corners, got)
+            for a, b in zip(emission_of(doc, name), q["radiance"]):
+                self.assertAlmostEqual(a, b, places=5)
+            for t in mesh_positions(doc, binary, name):  # the emitter's front faces the plane
+                self.assertLess(cross(sub(t[1], t[0]), sub(t[2], t[0]))[1], 0.0)
+        doc, _ = self.docs["punctual"]
+        model = [e for e in self.manifest["scenes"] if e["name"] == "punctual"][0]["reference"]["model"]
+        lights = doc["extensions"]["KHR_lights_punctual"]["lights"]
+        for kind, entries in (("point", model["points"]), ("spot", model["spots"])):
+            light = [l for l in lights if l["type"] == kind][0]
+            node = node_by_name(doc, kind)
+            self.assertEqual(tuple(node["translation"]), tuple(entries[0]["position"]))
+            for a, b in zip([c * light["intensity"] for c in light["color"]], entries[0]["intensity"]):
+                self.assertAlmostEqual(a, b, places=9)
+            if kind == "spot":
+                d = rotate(node["rotation"], (0.0, 0.0, -1.0))
+                for a, b in zip(d, entries[0]["direction"]):
+                    self.assertAlmostEqual(a, b, places=9)
+        for name in ("punctual", "lambert_quad"):  # Lambertian: no specular layer
+            doc, _ = self.docs[name]
+            plane = doc["materials"][doc["meshes"][mesh_by_name(doc, "plane")]["primitives"][0]["material"]]
+            self.assertEqual(plane["extensions"]["KHR_materials_specular"]["specularFactor"], 0.0)
+
+    def test_degenerate_scene_is_degenerate(self):
+        doc, binary = self.docs["degenerate"]
+        tris = mesh_positions(doc, binary, "degenerate")
+        areas = [tri_area(t) for t in tris]
+        self.assertGreaterEqual(sum(1 for a in areas if a == 0.0), 20)  # coincident or collinear
+        self.assertGreaterEqual(sum(1 for a in areas if 0.0 < a < 1e-6), 20)  # slivers
+        lights = [tri_area(t) for t in mesh_positions(doc, binary, "degenerate_lights")]
+        self.assertEqual(lights[0], 0.0)
+        self.assertTrue(0.0 < lights[1] < 1e-5)
+        prim = doc["meshes"][mesh_by_name(doc, "degenerate")]["primitives"][0]
+        self.assertNotIn("NORMAL", prim["attributes"])  # the loader must make its own
+
+    def test_scaled_scenes_are_scaled_copies(self):
+        base_doc, base_bin = self.docs["scale_1"]
+        for name, s in (("scale_1e-3", 1e-3), ("scale_1e4", 1e4)):
+            doc, binary = self.docs[name]
+            for mesh in base_doc["meshes"]:
+                a = mesh_positions(base_doc, base_bin, mesh["name"])
+                b = mesh_positions(doc, binary, mesh["name"])
+                self.assertEqual(len(a), len(b))
+                for ta, tb in zip(a, b):
+                    for va, vb in zip(ta, tb):
+                        for ca, cb in zip(va, vb):
+                            self.assertAlmostEqual(ca * s, cb, delta=1e-6 * s)
+            for mesh in doc["meshes"]:  # radiance does not scale
+                self.assertEqual(emission_of(doc, mesh["name"]), emission_of(base_doc, mesh["name"]))
+
+    def test_environment_map(self):
+        width, height, rows = rgbe.read_rgbe(os.path.join(FAILURE, "env_sun.hdr"))
+        self.assertEqual((width, height), (mfs.ENV_W, mfs.ENV_H))
+        # host/environment.h's convention: the centre column looks down -Z, row 0 is +Y.
+        for got, want in zip(rgbe.direction(0.5, 0.5), (0.0, 0.0, -1.0)):
+            self.assertAlmostEqual(got, want, places=12)
+        self.assertAlmostEqual(rgbe.direction(0.5, 0.0)[1], 1.0, places=12)
+        self.assertGreater(rgbe.direction(0.75, 0.5)[0], 0.999)  # u = 3/4: phi = pi/2, +X
+        for u, v in ((0.1, 0.3), (0.8, 0.7), (0.5, 0.5)):
+            back = rgbe.map_coordinates(rgbe.direction(u, v))
+            self.assertAlmostEqual(back[0], u, places=9)
+            self.assertAlmostEqual(back[1], v, places=9)
+        # The brightest pixel lies on the sun, and the sun's power is its radiance x solid angle.
+        best = max(((sum(rows[y][x]), x, y) for y in range(height) for x in range(width)))
+        d = rgbe.direction((best[1] + 0.5) / width, (best[2] + 0.5) / height)
+        sun = mfs._sun_direction()
+        self.assertLess(math.acos(min(1.0, dot(d, sun))), mfs.SUN_RADIUS + 2 * math.pi / height)
+        flux = 0.0
+        for y in range(height):
+            theta0, theta1 = math.pi * y / height, math.pi * (y + 1) / height
+            omega = 2 * math.pi / width * (math.cos(theta0) - math.cos(theta1))
+            for x in range(width):
+                dd = rgbe.direction((x + 0.5) / width, (y + 0.5) / height)
+                if math.acos(min(1.0, dot(dd, sun))) < mfs.SUN_RADIUS + 4 * math.pi / height:
+                    flux += (rows[y][x][0] - mfs.sky(dd)[0]) * omega
+        want = (mfs.SUN_RADIANCE[0] - mfs.sky(sun)[0]) * 2 * math.pi * (1 - math.cos(mfs.SUN_RADIUS))
+        self.assertAlmostEqual(flux / want, 1.0, delta=0.03)  # RGBE rounding and pixelation
+
+    def test_rgbe_round_trip(self):
+        for value in ((1.0, 0.5, 0.25), (2600.0, 2400.0, 2000.0), (1e-3, 0.0, 5e-4), (0.0, 0.0, 0.0)):
+            back = rgbe.decode(rgbe.encode(value))
+            for a, b in zip(value, back):
+                self.assertLessEqual(abs(a - b), max(value) * 2.0 ** -7)
+        self.assertEqual(rgbe.encode((0.0, 0.0, 0.0)), b"\0\0\0\0")
+
+    def test_builder_extensions_used_by_the_scenes(self):
+        b = gb.GltfBuilder()
+        b.material("lambert", specular=0.0)
+        b.material("glass", transmission=1.0, ior=1.5, thickness=1.0)
+        b.material("tinted", thickness=0.5, attenuation=((0.5, 0.6, 0.7), 2.0))
+        b.material("flat", unlit=True)
+        lambert, glass, tinted, flat = b.document()["materials"]
+        self.assertEqual(lambert["extensions"], {"KHR_materials_specular": {"specularFactor": 0.0}})
+        self.assertEqual(glass["extensions"]["KHR_materials_volume"], {"thicknessFactor": 1.0})
+        self.assertEqual(tinted["extensions"]["KHR_materials_volume"],
+                         {"thicknessFactor": 0.5, "attenuationColor": [0.5, 0.6, 0.7],
+                          "attenuationDistance": 2.0})
+        self.assertEqual(flat["extensions"], {"KHR_materials_unlit": {}})
+        self.assertEqual(b.document()["extensionsUsed"],
+                         ["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission",
+                          "KHR_materials_unlit", "KHR_materials_volume"])
+
+    def test_closed_box_is_closed(self):
+        """The shell's slabs overlap: a point just outside the inner space, across each of the
+        six walls and at every edge and corner, lies inside some slab (so no straight path
+        leaves the room without entering one through a face toward the room)."""
+        lo, hi, t = (-1, 0, -1), (1, 2, 1), 0.1
+        pos, _, _ = mfs.shell(lo, hi, t)
+        boxes = [pos[k:k + 24] for k in range(0, len(pos), 24)]  # box() gives 24 vertices
+        self.assertEqual(len(boxes), 6)
+        for cx in (0, 1, 2):
+            for cy in (0, 1, 2):
+                for cz in (0, 1, 2):
+                    if (cx, cy, cz) == (1, 1, 1):
+                        continue  # the room itself
+                    probe = [(lo[k] - t / 2, (lo[k] + hi[k]) / 2, hi[k] + t / 2)[c]
+                             for k, c in enumerate((cx, cy, cz))]
+                    inside = any(all(min(p[c] for p in bx) <= probe[c] <= max(p[c] for p in bx)
+                                     for c in range(3)) for bx in boxes)
+                    self.assertTrue(inside, "probe %s is in no slab" % probe)
 
 
 if __name__ == "__main__":

@@ -41,7 +41,7 @@ def pick_runs(benchmarks):
     chosen, order, repetitions = {}, [], 1
     for b in benchmarks:
         key = "/".join(base_name(b.get("run_name", b["name"])))
-        if key not in chosen:
+        if key not in order:  # (not `chosen`: with aggregates only, the mean comes first)
             order.append(key)
         repetitions = max(repetitions, int(b.get("repetitions", 1) or 1))
         if b.get("run_type") == "aggregate":
