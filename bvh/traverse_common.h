@@ -52,16 +52,13 @@ struct RayFrame {
 };
 
 struct PreparedRay {
-  float ox, oy, oz, dx, dy, dz, ix, iy, iz, tmin;
+  float ox, oy, oz, ix, iy, iz, tmin;
   RayFrame f;
   float o_kx, o_ky, o_kz;  // the origin in the frame's axes
   explicit PreparedRay(const Ray& r)
       : ox(r.o.x),
         oy(r.o.y),
         oz(r.o.z),
-        dx(r.d.x),
-        dy(r.d.y),
-        dz(r.d.z),
         ix(safe_rcp(r.d.x)),
         iy(safe_rcp(r.d.y)),
         iz(safe_rcp(r.d.z)),

@@ -42,8 +42,12 @@ inline void make_basis(float3 n, float3* t, float3* b) {
  * interpolated from a triangle's vertices: pbrt's error-bound idea): float rounding in both is a
  * small multiple of 2^-24 scale, whatever the ray's angle, so moving the origin by 2^-16 scale
  * along n clears it with a wide margin, at any scene scale and distance from the origin. */
+inline float offset_distance(float scale) {
+  return scale * (1.0f / 65536.0f);
+}
+
 inline float3 offset_origin(float3 p, float3 n, float scale) {
-  return p + n * (scale * (1.0f / 65536.0f));
+  return p + n * offset_distance(scale);
 }
 
 #endif /* WP_COMMON_H */

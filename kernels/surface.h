@@ -41,9 +41,9 @@ inline Surface surface_load(Paths paths, uint slot) {
  * (scenes/failure/closed_box). The pulled-back point is on the path's free side of every surface
  * the path did not cross. A refracted ray leaves on the far side, where there is no such point. */
 inline float3 surface_spawn(const Surface* s, float3 d_in, float t_in, float3 wi) {
-  const float shift = s->p_scale * (1.0f / 65536.0f);
   if (dot(wi, s->ng) > 0.0f) /* ng faces the incoming ray */
-    return offset_origin(s->p - d_in * fmin(shift, 0.5f * t_in), s->ng, s->p_scale);
+    return offset_origin(s->p - d_in * fmin(offset_distance(s->p_scale), 0.5f * t_in), s->ng,
+                         s->p_scale);
   return offset_origin(s->p, -s->ng, s->p_scale);
 }
 

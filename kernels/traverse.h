@@ -20,7 +20,6 @@
 
 typedef struct TraceRay {
   float ox, oy, oz;
-  float dx, dy, dz;
   float ix, iy, iz; /* clamped reciprocal direction */
   float tmin;
   uint alpha_key; /* identifies the ray's path and bounce for stochastic alpha (alpha.h) */
@@ -43,7 +42,6 @@ inline float safe_rcp(float d) {
 inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key) {
   TraceRay r;
   r.ox = o.x, r.oy = o.y, r.oz = o.z;
-  r.dx = d.x, r.dy = d.y, r.dz = d.z;
   r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
   r.tmin = tmin;
   r.alpha_key = alpha_key;

@@ -352,4 +352,21 @@ inline std::size_t compare_with_embree(const Mesh& mesh, const BuildOptions& opt
   return cmp.rays();
 }
 
+// The reference traversal of `bvh` (either width) against testing every stored triangle with the
+// same triangle test: the same triangle gives the same t bit for bit, a different one is a tie
+// (rare).
+inline void expect_matches_brute_force(const Mesh& mesh, const Bvh& bvh, unsigned seed) {
+  const std::vector<dev::IsectTri> all = stored_triangles(mesh);
+  Comparison cmp(mesh, bvh);
+  for (const Ray& ray : make_rays(bvh, 3000, 3000, seed)) {
+    const Hit brute = brute_force(all, ray);
+    const Hit ref = intersect_closest(bvh, ray);
+    if (ref.hit && brute.hit && ref.triangle == brute.triangle) {
+      EXPECT_EQ(ref.t, brute.t);
+    }
+    cmp.agree(ray, ref, brute);
+  }
+  EXPECT_LT(double(cmp.ties()), 1e-3 * double(cmp.rays()));
+}
+
 }  // namespace wp::bvh::test

@@ -39,7 +39,8 @@ has none.
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools"))
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(REPO, "tools"))
 import system_python  # noqa: E402
 
 system_python.need_numpy("test_accuracy.py")
@@ -49,8 +50,6 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(REPO, "tools"))
 import accuracy_lib as al  # noqa: E402
 import closed_form  # noqa: E402
 

@@ -208,17 +208,7 @@ TEST(BvhTraverse, MatchesBruteForceWithTheSameTriangleTest) {
       BuildOptions o;
       o.max_leaf_size = leaf;
       o.spatial_splits = splits;
-      const Bvh bvh = build(m.input(), o);
-      Comparison cmp(m, bvh);
-      for (const Ray& ray : make_rays(bvh, 3000, 3000, unsigned(leaf))) {
-        const Hit brute = brute_force(bvh.triangles, ray);
-        const Hit ref = intersect_closest(bvh, ray);
-        if (ref.hit && brute.hit && ref.triangle == brute.triangle) {
-          EXPECT_EQ(ref.t, brute.t);
-        }
-        cmp.agree(ray, ref, brute);
-      }
-      EXPECT_LT(double(cmp.ties()), 1e-3 * double(cmp.rays()));
+      expect_matches_brute_force(m, build(m.input(), o), unsigned(leaf));
     }
 }
 

@@ -354,21 +354,9 @@ Mesh culled_mix() {
 // culling flags, leaf sizes 1 and 16 and spatial splits.
 TEST(Bvh8Traverse, MatchesBruteForceWithTheSameTriangleTest) {
   const Mesh m = culled_mix();
-  const std::vector<dev::IsectTri> all = stored_triangles(m);
   for (const int leaf : {1, 16})
-    for (const bool splits : {false, true}) {
-      const Bvh bvh = build(m.input(), wide(leaf, splits));
-      Comparison cmp(m, bvh);
-      for (const Ray& ray : make_rays(bvh, 3000, 3000, unsigned(leaf))) {
-        const Hit brute = brute_force(all, ray);
-        const Hit ref = intersect_closest(bvh, ray);
-        if (ref.hit && brute.hit && ref.triangle == brute.triangle) {
-          EXPECT_EQ(ref.t, brute.t);
-        }
-        cmp.agree(ray, ref, brute);
-      }
-      EXPECT_LT(double(cmp.ties()), 1e-3 * double(cmp.rays()));
-    }
+    for (const bool splits : {false, true})
+      expect_matches_brute_force(m, build(m.input(), wide(leaf, splits)), unsigned(leaf));
 }
 
 // Both references use one triangle test on the same stored numbers: the same triangle gives the
