@@ -1,7 +1,9 @@
 #include "host/device_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 
 #include <glm/geometric.hpp>
 
@@ -18,13 +20,26 @@ dev::float4 f4(glm::vec4 v) {
   return {v.x, v.y, v.z, v.w};
 }
 
+// Every array starts at a 64-byte boundary and must end within reach of a 32-bit offset; an empty
+// one still takes 16 bytes. pack_scene and packed_end both place arrays with these.
+constexpr std::uint64_t kMaxEnd = 0xffffffffu;
+std::uint64_t aligned(std::uint64_t end) {
+  return (end + 63) & ~std::uint64_t(63);
+}
+std::uint64_t padded(std::uint64_t size) {
+  return std::max<std::uint64_t>(size, 16);
+}
+[[noreturn]] void too_large() {
+  throw Error("scene too large for 32-bit buffer offsets");
+}
+
 // Appends `items` at the next 64-byte boundary and returns its offset.
 template <class T>
 dev::uint append(std::vector<unsigned char>& bytes, const std::vector<T>& items) {
-  const std::size_t offset = (bytes.size() + 63) & ~std::size_t(63);
+  const std::size_t offset = aligned(bytes.size());
   const std::size_t size = items.size() * sizeof(T);
-  if (offset + size > 0xffffffffu) throw Error("scene too large for 32-bit buffer offsets");
-  bytes.resize(offset + std::max<std::size_t>(size, 16));
+  if (offset + size > kMaxEnd) too_large();
+  bytes.resize(offset + padded(size));
   if (size) std::memcpy(bytes.data() + offset, items.data(), size);
   return static_cast<dev::uint>(offset);
 }
@@ -78,6 +93,10 @@ void pack_images(const Scene& scene, std::vector<dev::TextureImage>& images,
       texels.push_back(dev::uint(img.rgba[4 * i]) | dev::uint(img.rgba[4 * i + 1]) << 8 |
                        dev::uint(img.rgba[4 * i + 2]) << 16 | dev::uint(img.rgba[4 * i + 3]) << 24);
   }
+}
+
+std::uint64_t ceil_div(std::uint64_t a, std::uint64_t b) {
+  return (a + b - 1) / b;
 }
 
 }  // namespace
@@ -164,6 +183,80 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
     d.env_height = static_cast<dev::uint>(x.env->height);
   }
   return p;
+}
+
+SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env) {
+  SceneCounts c;
+  c.triangles = scene.triangle_count();
+  c.vertices = scene.positions.size();
+  c.materials = scene.materials.size();
+  c.textures = scene.textures.size();
+  c.images = scene.images.size();
+  for (const Image& img : scene.images)
+    c.texels += std::uint64_t(std::max(img.width, 0)) * std::uint64_t(std::max(img.height, 0));
+  c.punctual_lights = scene.lights.size();
+  if (env) {
+    c.env_texels = env->texels.size();
+    c.env_marginal = env->marginal.size();
+    c.env_conditional = env->conditional.size();
+  }
+  return c;
+}
+
+BvhBytes bvh_bytes(const bvh::Bvh& b) {
+  if (b.width == WP_BVH8_WIDTH)
+    return {b.nodes8.size() * sizeof(dev::BvhNode8), b.blocks.size() * sizeof(dev::TriBlock4)};
+  return {b.nodes.size() * sizeof(dev::BvhNode), b.triangles.size() * sizeof(dev::IsectTri)};
+}
+
+BvhBytes min_bvh_bytes(std::uint64_t triangles, int width) {
+  // n inner nodes of at most `fan_out` children have fan_out * n child slots, which hold the n - 1
+  // non-root nodes and every leaf: n >= (leaves - 1) / (fan_out - 1).
+  const auto min_nodes = [](std::uint64_t leaves, std::uint64_t fan_out) {
+    return std::max<std::uint64_t>(1, ceil_div(leaves > 0 ? leaves - 1 : 0, fan_out - 1));
+  };
+  if (width == WP_BVH8_WIDTH) {
+    const std::uint64_t blocks = ceil_div(triangles, 4);
+    const std::uint64_t leaves = ceil_div(blocks, WP_BVH8_MAX_LEAF_BLOCKS);
+    return {min_nodes(leaves, WP_BVH8_WIDTH) * sizeof(dev::BvhNode8),
+            blocks * sizeof(dev::TriBlock4)};
+  }
+  const std::uint64_t leaves = ceil_div(triangles, WP_BVH_MAX_LEAF_SIZE);
+  return {min_nodes(leaves, 2) * sizeof(dev::BvhNode), triangles * sizeof(dev::IsectTri)};
+}
+
+std::uint64_t packed_end(const SceneCounts& c, const BvhBytes& bvh) {
+  // pack_scene's arrays in its order.
+  const std::uint64_t sizes[] = {bvh.nodes,
+                                 bvh.primitives,
+                                 c.triangles * sizeof(dev::uint4),  // tri_vertices
+                                 c.vertices * sizeof(dev::float4),  // positions
+                                 c.vertices * sizeof(dev::float4),  // normals
+                                 c.vertices * sizeof(dev::float4),  // tangents
+                                 c.vertices * sizeof(dev::float4),  // uvs
+                                 c.vertices * sizeof(dev::float4),  // colors
+                                 c.materials * sizeof(dev::Material),
+                                 c.textures * sizeof(dev::TextureRef),
+                                 c.images * sizeof(dev::TextureImage),
+                                 c.texels * sizeof(dev::uint),
+                                 c.punctual_lights * sizeof(dev::Light),
+                                 c.punctual_lights * sizeof(dev::LightAlias),
+                                 c.triangles * sizeof(std::uint32_t),  // tri_light
+                                 c.env_texels * sizeof(glm::vec4),
+                                 c.env_marginal * sizeof(float),
+                                 c.env_conditional * sizeof(float)};
+  const bool env = c.env_texels || c.env_marginal || c.env_conditional;
+  const std::size_t arrays = std::size(sizes) - (env ? 0 : 3);
+  std::uint64_t end = 0, last_end = 0;
+  for (std::size_t i = 0; i < arrays; ++i) {
+    last_end = aligned(end) + sizes[i];
+    end = aligned(end) + padded(sizes[i]);
+  }
+  return last_end;
+}
+
+void check_packed_size(const SceneCounts& counts, const BvhBytes& bvh) {
+  if (packed_end(counts, bvh) > kMaxEnd) too_large();
 }
 
 }  // namespace wp

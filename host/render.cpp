@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "bvh/bvh_cache.h"
+#include "host/device_scene.h"
 #include "host/error.h"
 
 namespace wp {
@@ -62,9 +63,14 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
   bool cached = false;
-  const bvh::Bvh bvh =
-      bvh::build_cached(bvh_input(scene, flags), bvh_options,
-                        options.bvh_cache ? bvh::cache_dir() : std::string(), &cached);
+  // A scene too large to pack (device_scene.h) fails now, not after its BVH is built (minutes for
+  // tens of millions of triangles) and cached: first with the least BVH its triangles need, then,
+  // before it is cached, with the BVH built.
+  const SceneCounts counts = scene_counts(scene, settings.environment.get());
+  check_packed_size(counts, min_bvh_bytes(counts.triangles, bvh_options.width));
+  const bvh::Bvh bvh = bvh::build_cached(
+      bvh_input(scene, flags), bvh_options, options.bvh_cache ? bvh::cache_dir() : std::string(),
+      &cached, [&counts](const bvh::Bvh& built) { check_packed_size(counts, bvh_bytes(built)); });
 
   Wavefront wavefront(runtime, scene, bvh, settings);
 
