@@ -3,16 +3,21 @@
 #include "host/environment.h"
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
-#include <memory>
+#include <fstream>
+#include <iterator>
 #include <system_error>
+#include <utility>
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
-#include <stb_image.h>
 
 #include "host/error.h"
 
@@ -33,24 +38,152 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-// Radiance RGBE through stb_image. stbi_is_hdr first: stbi_loadf would also decode an LDR image
-// (a PNG renamed .hdr) and invent radiance from it by undoing a guessed gamma.
-void read_hdr(const std::string& path, EnvironmentMap& env) {
-  if (!stbi_is_hdr(path.c_str())) throw Error(path + ": not a Radiance HDR (RGBE) file");
-  int w = 0, h = 0, channels = 0;
-  std::unique_ptr<float, void (*)(void*)> data(stbi_loadf(path.c_str(), &w, &h, &channels, 3),
-                                               stbi_image_free);
-  if (!data) {
-    const char* why = stbi_failure_reason();
-    throw Error(path + ": cannot decode the HDR image (" + (why ? why : "unknown error") + ")");
+// Radiance RGBE (.hdr), read here and not by stb_image: stbi_loadf loops forever on a truncated
+// run-length scanline or a zero-length run. Every count below is checked against the scanline
+// width and the bytes left, so any input ends in pixels or in one wp::Error naming the cause.
+//
+// Layout: "#?RADIANCE" (or "#?RGBE"), header lines up to an empty line (FORMAT=32-bit_rle_rgbe
+// required), the resolution line "-Y H +X W" (rows from the top, the only orientation read),
+// then H scanlines. A scanline starting 2, 2, hi, lo (hi < 128) is new-style run-length encoded:
+// hi * 256 + lo = W, then each of the 4 channels in turn as runs (count > 128: count - 128 copies
+// of the next byte) and literals (count 1..128: that many bytes). Any other scanline is W flat
+// RGBE pixels. Old-style runs (pixel 1, 1, 1, n) are read as pixels, as stb_image did.
+constexpr std::uint64_t kMaxHdrPixels = std::uint64_t{1} << 28;  // 4 GiB of texels
+
+class RgbeReader {
+ public:
+  RgbeReader(const std::string& path, std::vector<unsigned char> bytes)
+      : path_(path), b_(std::move(bytes)) {}
+
+  void read(EnvironmentMap& env) {
+    read_header();
+    const auto [w, h] = read_resolution();
+    env.width = w;
+    env.height = h;
+    env.texels.assign(std::size_t(w) * std::size_t(h), glm::vec4(0.0f));
+    std::vector<unsigned char> line(4 * std::size_t(w));
+    for (int y = 0; y < h; ++y) {
+      read_scanline(y, h, line);
+      for (int x = 0; x < w; ++x) {
+        const unsigned char* p = &line[4 * std::size_t(x)];
+        // stb_image's convention (scenes/rgbe.py's decode): m * 2^(e - 136), no half-step.
+        const float f = p[3] == 0 ? 0.0f : std::ldexp(1.0f, int(p[3]) - 136);
+        env.texels[std::size_t(y) * std::size_t(w) + std::size_t(x)] = {
+            float(p[0]) * f, float(p[1]) * f, float(p[2]) * f, 0.0f};
+      }
+    }
   }
-  if (w <= 0 || h <= 0) throw Error(path + ": the image is empty");
-  env.width = w;
-  env.height = h;
-  const std::size_t n = std::size_t(w) * std::size_t(h);
-  env.texels.resize(n);
-  const float* p = data.get();
-  for (std::size_t i = 0; i < n; ++i) env.texels[i] = {p[3 * i], p[3 * i + 1], p[3 * i + 2], 0.0f};
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const {
+    throw Error(path_ + ": not a valid Radiance HDR file: " + why);
+  }
+
+  // The next line without its '\n'; a file that ends first is truncated.
+  std::string next_line(const char* where) {
+    const auto begin = b_.begin() + std::ptrdiff_t(pos_);
+    const auto end = std::find(begin, b_.end(), '\n');
+    if (end == b_.end()) fail(std::string("truncated in the ") + where);
+    pos_ = std::size_t(end - b_.begin()) + 1;
+    return std::string(begin, end);
+  }
+
+  void read_header() {
+    const std::string magic = next_line("header");
+    if (magic != "#?RADIANCE" && magic != "#?RGBE")
+      fail("no #?RADIANCE or #?RGBE signature on the first line");
+    bool format = false;
+    for (std::string line = next_line("header"); !line.empty(); line = next_line("header")) {
+      if (line.rfind("FORMAT=", 0) != 0) continue;  // EXPOSURE, comments, ...: not needed
+      if (line != "FORMAT=32-bit_rle_rgbe")
+        fail("unsupported " + line.substr(0, 64) + " (only FORMAT=32-bit_rle_rgbe is read)");
+      format = true;
+    }
+    if (!format) fail("no FORMAT=32-bit_rle_rgbe line in the header");
+  }
+
+  // "-Y H +X W" with 0 < W * H <= kMaxHdrPixels; checked before anything is allocated.
+  std::pair<int, int> read_resolution() {
+    const std::string line = next_line("resolution line");
+    const auto number = [&](std::size_t& at) {
+      std::uint64_t v = 0;
+      const std::size_t start = at;
+      while (at < line.size() && std::isdigit(static_cast<unsigned char>(line[at])) &&
+             at - start < 10)
+        v = v * 10 + std::uint64_t(line[at++] - '0');
+      return at == start ? 0 : v;  // 0: missing, and also refused below
+    };
+    std::size_t at = 3;
+    std::uint64_t h = 0, w = 0;
+    const bool shape = line.rfind("-Y ", 0) == 0 && (h = number(at)) > 0 &&
+                       line.compare(at, 4, " +X ") == 0 && (at += 4, (w = number(at)) > 0) &&
+                       at == line.size();
+    if (!shape)
+      fail("resolution line '" + line.substr(0, 64) + "' is not '-Y <height> +X <width>'");
+    if (w > kMaxHdrPixels || h > kMaxHdrPixels || w * h > kMaxHdrPixels)
+      fail(std::to_string(w) + " x " + std::to_string(h) + " pixels is more than the 2^28 read");
+    // Cheapest possible scanline: 4 flat bytes a pixel, or 4 + 4 channels x 2 bytes a run of 127.
+    const std::uint64_t least = std::min<std::uint64_t>(4 * w, 4 + 8 * ((w + 126) / 127));
+    if (least * h > b_.size() - pos_)
+      fail("the file is too short for " + std::to_string(w) + " x " + std::to_string(h) +
+           " pixels");
+    return {int(w), int(h)};
+  }
+
+  const unsigned char* take(std::size_t n, int y, int h) {
+    if (n > b_.size() - pos_)
+      fail("truncated in scanline " + std::to_string(y) + " of " + std::to_string(h));
+    pos_ += n;
+    return &b_[pos_ - n];
+  }
+
+  void read_scanline(int y, int h, std::vector<unsigned char>& line) {
+    const std::size_t w = line.size() / 4;
+    const std::string at = "scanline " + std::to_string(y) + ": ";
+    const bool rle = w >= 8 && w < 32768 && b_.size() - pos_ >= 4 && b_[pos_] == 2 &&
+                     b_[pos_ + 1] == 2 && b_[pos_ + 2] < 128;
+    if (!rle) {
+      std::memcpy(line.data(), take(4 * w, y, h), 4 * w);
+      return;
+    }
+    const unsigned char* head = take(4, y, h);
+    const std::size_t declared = std::size_t(head[2]) << 8 | head[3];
+    if (declared != w)
+      fail(at + "run-length width " + std::to_string(declared) + " is not the image width " +
+           std::to_string(w));
+    for (std::size_t c = 0; c < 4; ++c) {
+      for (std::size_t x = 0; x < w;) {
+        const std::size_t count = *take(1, y, h);
+        const bool run = count > 128;
+        const std::size_t n = run ? count - 128 : count;
+        if (n == 0) fail(at + "zero-length run");
+        if (n > w - x)
+          fail(at + (run ? "run" : "literal") + " of " + std::to_string(n) + " at x " +
+               std::to_string(x) + " overruns the width " + std::to_string(w));
+        if (run) {
+          const unsigned char value = *take(1, y, h);
+          for (std::size_t k = 0; k < n; ++k) line[4 * (x + k) + c] = value;
+        } else {
+          const unsigned char* p = take(n, y, h);
+          for (std::size_t k = 0; k < n; ++k) line[4 * (x + k) + c] = p[k];
+        }
+        x += n;
+      }
+    }
+  }
+
+  const std::string& path_;
+  std::vector<unsigned char> b_;
+  std::size_t pos_ = 0;
+};
+
+void read_hdr(const std::string& path, EnvironmentMap& env) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error(path + ": read failed: " + std::strerror(errno));
+  RgbeReader(path, std::move(bytes)).read(env);
 }
 
 // OpenEXR: R, G and B of the data window (which may start anywhere), as 32-bit floats whatever

@@ -1,5 +1,5 @@
-// Environment lighting: an equirectangular radiance map (.hdr via stb_image, .exr via OpenEXR)
-// and the tables that importance-sample it (kernels/environment.h reads them).
+// Environment lighting: an equirectangular radiance map (.hdr by a bounded reader of its own, .exr
+// via OpenEXR) and the tables that importance-sample it (kernels/environment.h reads them).
 //
 // Direction convention (+Y up, glTF's frame): the map's u runs with the azimuth
 // phi = atan2(d.x, -d.z), u = (phi + pi) / (2 pi), so the centre column (u = 0.5) is seen looking
@@ -26,7 +26,8 @@ struct EnvironmentMap {
 };
 
 // Loads an equirectangular map. Throws wp::Error naming the file when it is missing, unreadable,
-// of an unsupported format, or holds non-finite or negative values.
+// of an unsupported format, malformed or truncated, larger than 2^28 texels, or holds non-finite or
+// negative values.
 EnvironmentMap load_environment(const std::string& path);
 
 // Builds the sampling tables and mean_luminance from texels/width/height.

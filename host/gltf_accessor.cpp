@@ -1,6 +1,7 @@
 #include "host/gltf_accessor.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -149,6 +150,11 @@ AccessorReader::AccessorReader(const tinygltf::Model& model, int accessor, const
     if (static_cast<std::size_t>(a.bufferView) < model.bufferViews.size()) {
       const std::size_t stride =
           model.bufferViews[static_cast<std::size_t>(a.bufferView)].byteStride;
+      // Elements would overlap; the validator refuses it and no writer means it.
+      if (stride != 0 && stride < element_size_)
+        throw Error(where + ": bufferView " + std::to_string(a.bufferView) + " byteStride " +
+                    std::to_string(stride) + " is smaller than the element size " +
+                    std::to_string(element_size_));
       if (stride != 0) stride_ = stride;
     }
     // view_range rejects a missing bufferView, so the stride above is always the view's.
@@ -211,6 +217,12 @@ void AccessorReader::read(std::size_t i, float* out) const {
   p += i * stride_;
   for (int c = 0; c < components_; ++c)
     out[c] = to_float(p + c * component_size_, component_type_, normalized_);
+  // NaN or Inf in a float attribute would poison the BVH, the shading or the texture lookups.
+  if (component_type_ == TINYGLTF_COMPONENT_TYPE_FLOAT)
+    for (int c = 0; c < components_; ++c)
+      if (!std::isfinite(out[c]))
+        throw Error("accessor " + std::to_string(index_) + " (" + what_ + "): element " +
+                    std::to_string(i) + " is not finite");
 }
 
 std::vector<std::uint32_t> AccessorReader::read_indices() const {

@@ -104,6 +104,34 @@ std::size_t check_glb(const std::vector<unsigned char>& b) {
   return static_cast<std::size_t>(length);
 }
 
+// tinygltf converts the parsed JSON into its model recursively, so a document nested thousands
+// deep (e.g. in free-form "extras") overflows the stack. glTF's own structure nests under ten
+// levels (nodes refer to each other by index), so anything deeper than this is refused before
+// tinygltf sees it.
+constexpr int kMaxJsonDepth = 64;
+
+// Counts [ and { nesting outside strings (skipping escaped characters) in JSON text.
+void check_json_depth(const unsigned char* text, std::size_t size) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < size; ++i) {
+    const unsigned char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // the escaped character cannot end the string
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error("JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
 // Parses the file with tinygltf (.glb when it starts with the binary magic, else JSON text);
 // tinygltf's warnings go to `warnings`, one line each.
 tinygltf::Model parse(const std::string& path, std::vector<std::string>* warnings) {
@@ -122,9 +150,13 @@ tinygltf::Model parse(const std::string& path, std::vector<std::string>* warning
   try {
     if (glb) {
       const std::size_t length = check_glb(bytes);
+      std::uint32_t json_length = 0;  // check_glb has checked that the chunk lies in the file
+      std::memcpy(&json_length, &bytes[12], 4);
+      check_json_depth(bytes.data() + 20, json_length);
       ok = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                        static_cast<unsigned int>(length), base);
     } else {
+      check_json_depth(bytes.data(), bytes.size());
       ok = loader.LoadASCIIFromString(&model, &err, &warn,
                                       reinterpret_cast<const char*>(bytes.data()),
                                       static_cast<unsigned int>(bytes.size()), base);
@@ -235,6 +267,9 @@ void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
   const tinygltf::Mesh& mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
   for (std::size_t i = 0; i < mesh.primitives.size(); ++i) {
     const tinygltf::Primitive& p = mesh.primitives[i];
+    if (p.mode < 0 || p.mode > 6)  // tinygltf gives 4 (TRIANGLES) when "mode" is absent
+      throw Error("mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(i) +
+                  ": mode " + std::to_string(p.mode) + " is not a glTF primitive mode (0-6)");
     if (!gltf::is_triangle_mode(p.mode)) {
       static const char* const kModes[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
       const std::string mode = p.mode <= 3 ? kModes[p.mode] : std::to_string(p.mode);
@@ -292,6 +327,10 @@ void SceneBuilder::warn_once(int mesh, std::size_t primitive, const std::string&
 }
 
 void compute_bounds(Scene& scene) {
+  if (scene.positions.empty()) {  // an empty scene: a point at the origin, not inverted bounds
+    scene.bounds_lo = scene.bounds_hi = glm::vec3(0.0f);
+    return;
+  }
   scene.bounds_lo = glm::vec3(std::numeric_limits<float>::max());
   scene.bounds_hi = glm::vec3(std::numeric_limits<float>::lowest());
   for (const glm::vec3& p : scene.positions) {
@@ -308,6 +347,10 @@ Scene load_gltf(const std::string& path) {
   const tinygltf::Model model = parse(path, &scene.warnings);
   check_extensions(model, path, &scene.warnings);
   try {
+    // glTF 1.0 files differ in structure; tinygltf reads some of them as 2.0 nonsense.
+    if (model.asset.version.rfind("2.", 0) != 0)
+      throw Error("asset.version \"" + model.asset.version.substr(0, 32) +
+                  "\" is not 2.x (only glTF 2.0 is supported)");
     if (model.scenes.empty()) throw Error("the file has no scenes");
     const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (static_cast<std::size_t>(scene_index) >= model.scenes.size())
@@ -316,8 +359,10 @@ Scene load_gltf(const std::string& path) {
     for (std::size_t i = 0; i < model.materials.size(); ++i)
       scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i), textures));
     SceneBuilder(model, scene).build(scene_index);
+    // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
     if (scene.triangle_count() == 0)
-      throw Error("no triangles in scene " + std::to_string(scene_index));
+      scene.warnings.push_back(path + ": scene " + std::to_string(scene_index) +
+                               " has no triangles; only the background will be seen");
   } catch (const Error& e) {
     throw Error(path + ": " + e.what());
   }

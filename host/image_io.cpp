@@ -1,9 +1,15 @@
 #include "host/image_io.h"
 
+#include <pthread.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <random>
 
 #include <ImfChannelList.h>
@@ -92,6 +98,68 @@ std::string temporary_name(const std::string& path) {
       .string();
 }
 
+// Temporary files on disk while write_images runs, for the SIGINT/SIGTERM handler below: a fixed
+// array of pointers into strings that outlive the registration, since a handler may not allocate
+// or take locks. A count is published only after its entries are written.
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+const char* g_temp_paths[64];
+volatile std::sig_atomic_t g_temp_count = 0;
+
+// Removes the temporary files (unlink is async-signal-safe; a name not yet created or already
+// renamed fails harmlessly), then dies of the same signal with its default action.
+extern "C" void remove_temps_and_reraise(int sig) {
+  for (int i = 0; i < g_temp_count; ++i) ::unlink(g_temp_paths[i]);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);  // delivered when the handler returns (the signal is blocked inside it)
+}
+
+// While alive: `paths` are removed if the process is interrupted (SIGINT, SIGTERM, SIGHUP) and the
+// previous handlers are restored afterwards. One at a time (write_images is not reentrant).
+class TempFileGuard {
+ public:
+  explicit TempFileGuard(const std::vector<std::string>& paths) {
+    if (paths.size() > std::size(g_temp_paths))
+      throw Error("too many output files (" + std::to_string(paths.size()) + ")");
+    for (std::size_t i = 0; i < paths.size(); ++i) g_temp_paths[i] = paths[i].c_str();
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    g_temp_count = static_cast<std::sig_atomic_t>(paths.size());
+    struct sigaction action {};
+    action.sa_handler = remove_temps_and_reraise;
+    sigemptyset(&action.sa_mask);
+    for (const int sig : kSignals) sigaddset(&action.sa_mask, sig);  // one handler at a time
+    for (std::size_t i = 0; i < std::size(kSignals); ++i)
+      sigaction(kSignals[i], &action, &previous_[i]);
+  }
+  ~TempFileGuard() {
+    for (std::size_t i = 0; i < std::size(kSignals); ++i)
+      sigaction(kSignals[i], &previous_[i], nullptr);
+    g_temp_count = 0;
+  }
+  TempFileGuard(const TempFileGuard&) = delete;
+  TempFileGuard& operator=(const TempFileGuard&) = delete;
+
+ private:
+  struct sigaction previous_[std::size(kSignals)]{};
+};
+
+// Blocks the guarded signals while alive: the renames that publish a set of outputs then complete
+// as a whole, and a signal that came meanwhile is handled just after.
+class BlockSignals {
+ public:
+  BlockSignals() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (const int sig : kSignals) sigaddset(&set, sig);
+    pthread_sigmask(SIG_BLOCK, &set, &previous_);
+  }
+  ~BlockSignals() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
+  BlockSignals(const BlockSignals&) = delete;
+  BlockSignals& operator=(const BlockSignals&) = delete;
+
+ private:
+  sigset_t previous_;
+};
+
 }  // namespace
 
 unsigned char png_encode(float linear, const PngOptions& png) {
@@ -112,32 +180,35 @@ void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
       throw Error(path + ": unsupported output format (use .exr, .png or .pfm)");
     if (ext == ".pfm" && variance) all.push_back(variance_path(path));
   }
+  // Every temporary name is chosen before the first is created, so that an interruption at any
+  // point finds all of them registered with the signal handler.
   std::vector<std::string> temps;
-  const auto remove_temps = [&] {
-    for (const auto& t : temps) std::remove(t.c_str());
-  };
+  for (const auto& path : all) temps.push_back(temporary_name(path));
+  const TempFileGuard guard(temps);
+  std::size_t current = 0;  // the file being written, for messages
   try {
-    for (const auto& path : all) {
-      temps.push_back(temporary_name(path));
+    for (; current < all.size(); ++current) {
+      const std::string& path = all[current];
+      const std::string& temp = temps[current];
       const std::string ext = extension_of(path);
       if (ext == ".exr")
-        write_exr(temps.back(), image, exr_attributes, variance);
+        write_exr(temp, image, exr_attributes, variance);
       else if (ext == ".png")
-        write_png(temps.back(), image, png);
+        write_png(temp, image, png);
       else if (variance && path.size() > 13 &&
                path.compare(path.size() - 13, 13, ".variance.pfm") == 0 &&
                std::find(paths.begin(), paths.end(), path) == paths.end())
-        write_pfm(temps.back(), *variance);
+        write_pfm(temp, *variance);
       else
-        write_pfm(temps.back(), image);
+        write_pfm(temp, image);
     }
-    for (std::size_t i = 0; i < all.size(); ++i) std::filesystem::rename(temps[i], all[i]);
-  } catch (const Error& e) {
-    remove_temps();
-    throw;
+    const BlockSignals block;
+    for (current = 0; current < all.size(); ++current)
+      std::filesystem::rename(temps[current], all[current]);
   } catch (const std::exception& e) {
-    remove_temps();
-    throw Error("cannot write " + all[temps.empty() ? 0 : temps.size() - 1] + ": " + e.what());
+    for (const auto& t : temps) std::remove(t.c_str());  // also those not (yet) created: harmless
+    if (dynamic_cast<const Error*>(&e)) throw;
+    throw Error("cannot write " + all[std::min(current, all.size() - 1)] + ": " + e.what());
   }
 }
 

@@ -2,13 +2,16 @@
 // Errors of every kind end here, in one place: one line on stderr, exit status 1.
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <limits>
-#include <memory>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -56,7 +59,9 @@ int list_devices() {
   return 0;
 }
 
-// Fails before any rendering when an output could not be written at the end.
+// Fails before any rendering when an output could not be written at the end: outputs are written
+// beside their destination under a temporary name and renamed into place (image_io.h), which
+// needs a writable folder; an existing file that is not writable is not replaced either.
 void check_outputs(const std::vector<std::string>& outputs) {
   for (const auto& o : outputs) {
     const std::filesystem::path p(o);
@@ -67,7 +72,32 @@ void check_outputs(const std::vector<std::string>& outputs) {
     const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
     if (!std::filesystem::is_directory(dir))
       throw wp::Error(o + ": folder " + dir.string() + " does not exist");
+    if (access(dir.c_str(), W_OK | X_OK) != 0)
+      throw wp::Error(o + ": folder " + dir.string() + " is not writable (" + std::strerror(errno) +
+                      ")");
+    std::error_code ec;
+    const auto status = std::filesystem::symlink_status(p, ec);
+    if (std::filesystem::is_directory(status)) throw wp::Error(o + ": is a directory");
+    if (std::filesystem::exists(status) && access(p.c_str(), W_OK) != 0)
+      throw wp::Error(o + ": the existing file is not writable (" + std::strerror(errno) + ")");
   }
+}
+
+// Ranges CLI11 cannot express and wp::validate (render.h) does not cover: these are the command
+// line's own, so they are checked here, before anything is loaded.
+void check_options(const CLI::App& render, const CliOptions& cli,
+                   const wp::RenderSettings& settings) {
+  const auto check = [](bool ok, const std::string& what) {
+    if (!ok) throw wp::Error(what);
+  };
+  // -1 is the internal "not given" value; a user who types it means a camera that cannot exist.
+  check(render.count("--camera") == 0 || settings.camera >= 0,
+        "--camera " + std::to_string(settings.camera) + ": camera indices start at 0");
+  check(std::isfinite(cli.exposure) && std::abs(cli.exposure) <= 64.0f,
+        "--exposure must be a finite number of stops between -64 and 64");
+  check(settings.spp <= (1 << 20), "--spp must be at most 1048576");
+  check(settings.wave_size <= (std::size_t{1} << 24), "--wave-size must be at most 16777216");
+  check(settings.local_size <= 1024, "--local-size must be at most 1024");
 }
 
 class Progress {
@@ -86,9 +116,10 @@ class Progress {
   bool enabled_;
 };
 
-int render_command(CliOptions& cli, wp::RenderSettings& settings) {
+int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings) {
   if (cli.outputs.empty()) cli.outputs = {"render.exr", "render.png"};
   check_outputs(cli.outputs);
+  check_options(render, cli, settings);
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
   settings.strategy = cli.strategy == "nee"    ? wp::Strategy::kNee
@@ -105,6 +136,10 @@ int render_command(CliOptions& cli, wp::RenderSettings& settings) {
 
   const auto start = std::chrono::steady_clock::now();
   const wp::Scene scene = wp::load_gltf(cli.scene);
+  // Known now, not only once the kernels are built and the BVH is made.
+  if (settings.camera >= 0 && static_cast<std::size_t>(settings.camera) >= scene.cameras.size())
+    throw wp::Error("--camera " + std::to_string(settings.camera) + ": the scene has " +
+                    std::to_string(scene.cameras.size()) + " camera(s)");
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!cli.quiet)
@@ -145,7 +180,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   // Parse errors in one line, like every other error.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return std::string("wavepath: error: ") + e.what() + " (see --help)\n";
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    return "wavepath: error: " + what + " (see --help)\n";
   });
   app.set_version_flag("--version", "wavepath 0.1.0");
   CLI::App* devices = app.add_subcommand("devices", "List OpenCL platforms and devices");
@@ -235,11 +272,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // app.exit prints help and version (status 0) or the one-line error above; CLI11's own codes
+    // (104, 106, ...) become 1, the status of every wavepath error.
+    return app.exit(e) == 0 ? 0 : 1;
   }
   try {
     if (devices->parsed()) return list_devices();
-    return render_command(cli, settings);
+    return render_command(*render, cli, settings);
   } catch (const wp::Error& e) {
     std::cerr << "wavepath: error: " << e.what() << "\n";
     if (!e.details().empty()) std::cerr << e.details() << "\n";

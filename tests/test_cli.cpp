@@ -2,12 +2,17 @@
 // stderr naming the cause and a non-zero exit, leaves no output file and overwrites nothing; a good
 // run writes both images, records its settings in the EXR header and prints JSON.
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -111,6 +116,105 @@ TEST_F(Cli, BadOptionValues) {
   expect_error(run("render '" + cornell() + "' -o out.jpg"), "out.jpg");
   expect_error(run("render '" + cornell() + "' -o missing_dir/out.exr"), "missing_dir");
   expect_error(run("render '" + cornell() + "' --features some"), "features");
+}
+
+// CLI11's own exit codes (104, 106, ...) are not the documented 1; help and version still exit 0.
+TEST_F(Cli, ParseErrorsExitWithStatusOne) {
+  const std::string scene = "render '" + cornell() + "' ";
+  for (const std::string& args :
+       {scene + "--height abc", scene + "--spp 1.5", scene + "--no-such-option", scene + "--seed",
+        scene + "--env-color 1,2", scene + "--tonemap sepia", std::string("render"),
+        std::string(""), std::string("frobnicate")}) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.status, 1) << args << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("wavepath: error: ", 0), 0u) << args << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
+  }
+  EXPECT_EQ(run("render --help").status, 0);
+  EXPECT_EQ(run("--version").status, 0);
+}
+
+// Values CLI11 parses but wavepath cannot use: refused with status 1 before anything is loaded.
+TEST_F(Cli, OutOfRangeOptionValues) {
+  const std::string scene = "render '" + cornell() + "' ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--camera -1", "--camera -1"},        {"--camera 1", "--camera 1: the scene has 1 camera"},
+      {"--exposure nan", "--exposure"},      {"--exposure inf", "--exposure"},
+      {"--exposure 1e6", "--exposure"},      {"--spp 2000000", "--spp"},
+      {"--local-size 4096", "--local-size"}, {"--wave-size 100000000", "--wave-size"}};
+  for (const auto& [args, cause] : cases) {
+    const CliRun r = run(scene + args + " --width 8 --height 8 --spp 1");
+    EXPECT_EQ(r.status, 1) << args;
+    expect_error(r, cause);
+  }
+}
+
+// An output that cannot be written is found before rendering: the folder is not writable, the
+// output is a folder, or an existing file is not writable (which would otherwise be replaced).
+// As root, permissions bind only when wavepath runs as another user: setpriv drops to nobody.
+TEST_F(Cli, UnwritableOutputFailsBeforeRendering) {
+  const std::string scene = "render '" + cornell() + "' --width 8 --height 8 --spp 1 ";
+  fs::create_directories(dir_ / "keep.exr");
+  expect_error(run(scene + "-o keep.exr"), "keep.exr: is a directory");
+  fs::remove(dir_ / "keep.exr");
+
+  std::string as_user;
+  if (::geteuid() == 0) {
+    if (!fs::exists("/usr/bin/setpriv")) GTEST_SKIP() << "root without setpriv";
+    as_user = "/usr/bin/setpriv --reuid=65534 --regid=65534 --clear-groups";
+  }
+  // A folder ("kernels", which expect_error allows) not writable by the user wavepath runs as.
+  const fs::path sub = dir_ / "kernels";
+  fs::create_directories(sub);
+  fs::permissions(sub, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                           fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  expect_error(run(scene + "-o kernels/out.exr", as_user), "kernels is not writable");
+  // Writable by all now, holding a read-only file.
+  fs::permissions(sub, fs::perms::all);
+  std::ofstream(sub / "keep.exr") << "old";
+  fs::permissions(sub / "keep.exr",
+                  fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  expect_error(run(scene + "-o kernels/keep.exr", as_user),
+               "kernels/keep.exr: the existing file is not writable");
+  EXPECT_EQ(slurp(sub / "keep.exr"), "old");
+  EXPECT_EQ(std::distance(fs::directory_iterator(sub), fs::directory_iterator()), 1);
+}
+
+// SIGTERM while the outputs are written: the temporary files are removed and the process dies of
+// the signal; no output appears. A forked writer of a large noisy image (slow to compress) is
+// signalled as soon as its first temporary file exists.
+TEST_F(Cli, InterruptedWriteLeavesNoTemporaryFile) {
+  wp::ImageRgb img;
+  img.width = img.height = 3000;
+  img.rgb.resize(3 * std::size_t(img.width) * std::size_t(img.height));
+  std::mt19937 rng(1);
+  for (float& v : img.rgb) v = std::uniform_real_distribution<float>(0.0f, 4.0f)(rng);
+  const std::vector<std::string> outputs = {(dir_ / "big.exr").string(),
+                                            (dir_ / "big.png").string()};
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      wp::write_images(outputs, img, {});
+    } catch (...) {
+    }
+    ::_exit(0);
+  }
+  const auto temporary = [&] {
+    for (const auto& e : fs::directory_iterator(dir_))
+      if (e.path().filename().string().find(".tmp") != std::string::npos) return true;
+    return false;
+  };
+  bool seen = false;
+  for (int i = 0; i < 20000 && !(seen = temporary()); ++i) ::usleep(500);
+  ::kill(child, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(seen) << "no temporary file appeared";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer finished before the signal; status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  for (const auto& e : fs::directory_iterator(dir_))
+    ADD_FAILURE() << "left behind: " << e.path().filename();
 }
 
 TEST_F(Cli, NoOpenClDevice) {

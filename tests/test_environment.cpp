@@ -2,11 +2,15 @@
 // convention on the device (host/environment.h), and env_sample against env_pdf: chi-square on
 // equal-area sphere bins, pdf agreement per sample, normalisation, and an unbiased estimator of the
 // map's integral over the sphere.
+#include <array>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <random>
@@ -196,6 +200,172 @@ TEST(EnvironmentLoad, Refusals) {
   for (const std::string& p : {text, text_exr, png, bad}) std::filesystem::remove(p);
   wp::EnvironmentMap empty;
   EXPECT_THROW(wp::build_environment_tables(empty), wp::Error);
+}
+
+// ---- Radiance RGBE: the bounded reader ---------------------------------------------------------
+
+using Rgbe = std::array<unsigned char, 4>;
+
+// The floats the loader must give for one RGBE pixel: m * 2^(e - 136), 0 when e = 0 (stb_image's
+// convention, scenes/rgbe.py's decode). Exact in float: 8 mantissa bits times a power of two.
+glm::vec3 rgbe_value(const Rgbe& p) {
+  if (p[3] == 0) return glm::vec3(0.0f);
+  const auto f = [&](int c) { return static_cast<float>(std::ldexp(double(p[c]), p[3] - 136)); };
+  return {f(0), f(1), f(2)};
+}
+
+std::string hdr_header(int w, int h) {
+  return "#?RADIANCE\n# made by test_environment\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1.0\n\n-Y " +
+         std::to_string(h) + " +X " + std::to_string(w) + "\n";
+}
+
+// One new-style run-length scanline: 2, 2, width, then each channel as runs (3 or more equal
+// bytes, count 128 + n) and literals (count n <= 128) between them.
+std::string rle_scanline(const std::vector<Rgbe>& px) {
+  const std::size_t w = px.size();
+  std::string out = {2, 2, char(w >> 8), char(w & 255)};
+  for (std::size_t c = 0; c < 4; ++c) {
+    const auto run_at = [&](std::size_t x) {
+      std::size_t n = 1;
+      while (x + n < w && n < 127 && px[x + n][c] == px[x][c]) ++n;
+      return n;
+    };
+    for (std::size_t x = 0; x < w;) {
+      if (const std::size_t n = run_at(x); n >= 3) {
+        out += char(128 + n);
+        out += char(px[x][c]);
+        x += n;
+        continue;
+      }
+      const std::size_t start = x;
+      while (x < w && x - start < 128 && run_at(x) < 3) ++x;
+      out += char(x - start);
+      for (std::size_t k = start; k < x; ++k) out += char(px[k][c]);
+    }
+  }
+  return out;
+}
+
+// A 16 x 3 image with runs and literals in every channel, and a pixel with e = 0.
+std::vector<Rgbe> rle_pixels(int w, int h) {
+  std::vector<Rgbe> px;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      px.push_back({static_cast<unsigned char>(128 + (x / 4) * 8),
+                    static_cast<unsigned char>((x * 37 + y * 11) % 256), 200,
+                    static_cast<unsigned char>(x == 5 && y == 1 ? 0 : 120 + 4 * y)});
+  return px;
+}
+
+std::string rle_file(int w, int h, const std::vector<Rgbe>& px) {
+  std::string bytes = hdr_header(w, h);
+  for (int y = 0; y < h; ++y)
+    bytes += rle_scanline(std::vector<Rgbe>(px.begin() + y * w, px.begin() + (y + 1) * w));
+  return bytes;
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+void expect_exact(const wp::EnvironmentMap& env, int w, int h, const std::vector<Rgbe>& px) {
+  ASSERT_EQ(env.width, w);
+  ASSERT_EQ(env.height, h);
+  ASSERT_EQ(env.texels.size(), px.size());
+  for (std::size_t i = 0; i < px.size(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(env.texels[i][c], rgbe_value(px[i])[c]) << i << " " << c;
+}
+
+TEST(EnvironmentLoad, HdrRunLengthAndFlatDecodeExactly) {
+  const std::string path = temp_file("exact.hdr");
+  const std::vector<Rgbe> rle = rle_pixels(16, 3);
+  write_file(path, rle_file(16, 3, rle));
+  expect_exact(wp::load_environment(path), 16, 3, rle);
+  // Flat scanlines: required below 8 pixels wide, and what scenes/rgbe.py writes at any width.
+  for (const int w : {5, 12}) {
+    const std::vector<Rgbe> flat = rle_pixels(w, 2);
+    std::string bytes = hdr_header(w, 2);
+    for (const Rgbe& p : flat) bytes.append(p.begin(), p.end());
+    write_file(path, bytes);
+    expect_exact(wp::load_environment(path), w, 2, flat);
+  }
+  std::filesystem::remove(path);
+}
+
+// Runs `body` on a thread and fails the whole test program if it takes more than a minute: the
+// reader it checks used to loop forever, and a hang must show as a failure, not a stuck test.
+void within_a_minute(const std::function<void()>& body) {
+  auto done = std::async(std::launch::async, body);
+  if (done.wait_for(std::chrono::seconds(60)) == std::future_status::timeout) {
+    std::fprintf(stderr, "FAILED: the HDR reader hangs\n");
+    std::_Exit(1);
+  }
+  done.get();
+}
+
+// Expects load_environment to throw wp::Error naming the file and `needle`, all on one line.
+void expect_hdr_error(const std::string& path, const std::string& bytes, const std::string& needle,
+                      const std::string& what) {
+  write_file(path, bytes);
+  try {
+    wp::load_environment(path);
+    ADD_FAILURE() << what << ": accepted";
+  } catch (const wp::Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(path), std::string::npos) << what << ": " << message;
+    EXPECT_NE(message.find(needle), std::string::npos) << what << ": " << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << what << ": " << message;
+  }
+}
+
+TEST(EnvironmentLoad, HdrTruncatedAtEveryByteIsAnError) {
+  const std::string path = temp_file("truncated.hdr");
+  const std::string bytes = rle_file(16, 3, rle_pixels(16, 3));
+  within_a_minute([&] {
+    for (std::size_t n = 0; n < bytes.size(); ++n)
+      expect_hdr_error(path, bytes.substr(0, n), "", "truncated to " + std::to_string(n));
+    // Cut inside the second scanline's run-length data: the message names it.
+    expect_hdr_error(path, bytes.substr(0, bytes.size() - 30), "truncated in scanline 2 of 3",
+                     "cut in scanline 2");
+  });
+  std::filesystem::remove(path);
+}
+
+TEST(EnvironmentLoad, HdrCorruptRunsAndHeadersAreErrors) {
+  const std::string path = temp_file("corrupt.hdr");
+  const std::string good = rle_file(16, 3, rle_pixels(16, 3));
+  const std::size_t data = hdr_header(16, 3).size();  // scanline 0: 2, 2, 0, 16, then channel R
+  const auto patched = [&](std::size_t at, char value) {
+    std::string b = good;
+    b[at] = value;
+    return b;
+  };
+  within_a_minute([&] {
+    expect_hdr_error(path, patched(data + 4, char(128 + 17)), "scanline 0: run of 17",
+                     "run past the width");
+    expect_hdr_error(path, patched(data + 4, 17), "scanline 0: literal of 17", "literal past");
+    expect_hdr_error(path, patched(data + 4, 0), "scanline 0: zero-length run", "zero run");
+    expect_hdr_error(path, patched(data + 3, 15), "run-length width 15", "width mismatch");
+    const std::string pixels = good.substr(data);
+    const std::vector<std::pair<std::string, std::string>> headers = {
+        {"#?JPEG\nFORMAT=32-bit_rle_rgbe\n\n-Y 3 +X 16\n", "signature"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 3 +X 16\n", "FORMAT=32-bit_rle_xyze"},
+        {"#?RADIANCE\n\n-Y 3 +X 16\n", "no FORMAT"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n", "truncated in the header"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n", "truncated in the resolution line"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+Y 3 +X 16\n", "resolution line"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 16\n", "resolution line"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 3 +X -16\n", "resolution line"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 3 +X 16x\n", "resolution line"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 99999 +X 99999\n", "more than the 2^28"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 9999999999 +X 9999999999\n", "2^28"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16384 +X 16384\n", "too short"}};
+    for (const auto& [header, needle] : headers)  // a truncated header ends the file
+      expect_hdr_error(path, header + (needle.rfind("truncated", 0) == 0 ? "" : pixels), needle,
+                       header);
+  });
+  std::filesystem::remove(path);
 }
 
 // ---- Tables -----------------------------------------------------------------------------------
