@@ -12,7 +12,7 @@ __kernel void accumulate(WP_STAGE_PARAMS, __global float4* film) {
   if (slot >= launch.path_count) return;
   const float3 l = paths.radiance[slot].xyz;
   if (!all(isfinite(l))) {
-    atomic_inc(&queues.counters[WP_COUNTER_NONFINITE]);
+    count_nonfinite(queues);
     return;
   }
   const uint pixel = paths.info[slot].x;

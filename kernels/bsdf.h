@@ -17,13 +17,15 @@
  *   and light passes through unbent: the transmitted lobe is the reflected one mirrored through
  *   the surface.
  *
- * A surface with roughness <= WP_DELTA_ROUGHNESS is perfectly smooth: its specular reflection and
+ * A surface with roughness^2 < WP_DELTA_ALPHA is perfectly smooth: its specular reflection and
  * transmission are delta lobes (a flag, not a pdf), which evaluation leaves out (they have no
  * density). The diffuse term stays an ordinary lobe.
  *
- * Sampling first picks a lobe - specular reflection, transmission or diffuse - with probabilities
- * proportional to their Fresnel-weighted albedo estimates at n.v (a function of wo alone), then a
- * direction: GGX visible normals for reflection and transmission, cosine-weighted for diffuse.
+ * Sampling first picks the microfacet lobes or the diffuse one, with probabilities proportional to
+ * their Fresnel-weighted albedo estimates at n.v (a function of wo alone). The microfacet lobes
+ * draw a normal h from GGX's visible normals and then choose reflection or transmission at that
+ * microfacet, in proportion to its Fresnel weights at wo.h (as pbrt-v4's dielectric does); the
+ * diffuse lobe is cosine-weighted.
  * For non-delta lobes the returned pdf is the mixture density of all lobes at wi, the number
  * bsdf_eval returns for the pair. Directions are world-space unit vectors pointing away from the
  * surface; wo is toward the viewer. Surfaces seen from the back of a volume (the ray travels
@@ -35,7 +37,10 @@
 #include "common.h"
 #include "sampling.h"
 
-#define WP_DELTA_ROUGHNESS 0.01f
+/* A surface whose GGX alpha (roughness^2) is below this is perfectly smooth. The lobe of alpha
+ * 1e-3 is ~0.06 degrees wide: narrower than any pixel of a sensible camera, and the float32
+ * evaluation of a narrower one loses its precision (sampling.h, ggx_d). */
+#define WP_DELTA_ALPHA 1e-3f
 
 /* Surface flags. */
 #define WP_SURF_UNLIT 1u  /* KHR_materials_unlit: shows `color`, scatters nothing */
@@ -60,19 +65,24 @@ typedef struct BsdfEval {
 
 typedef struct BsdfSample {
   float3 wi;
-  float3 weight; /* f * |n.wi| / pdf, or a delta lobe's weight / its selection probability */
-  float pdf;     /* 0 for a delta lobe */
+  float3 weight;   /* f * |n.wi| / pdf, or a delta lobe's weight / its selection probability */
+  float pdf;       /* 0 for a delta lobe */
+  float eta_scale; /* eta^2 when the sample refracted into another medium (the 1/eta^2 in
+                    * weight), else 1: Russian roulette divides it out of the throughput */
   bool delta;
   bool valid; /* false: the path ends here (no direction, or one on the wrong side) */
 } BsdfSample;
 
-/* Lobe selection probabilities; they sum to 1. */
+/* Lobe selection probabilities; they sum to 1. spec + trans is the probability of the
+ * microfacet lobes together (reflection and transmission share one sampled microfacet normal and
+ * choose between them per microfacet, microfacet_reflect_prob); spec and trans apart are the
+ * split at the macro normal, which is the split of a smooth surface's delta lobes. */
 typedef struct Lobes {
   float spec, trans, diff;
 } Lobes;
 
 inline bool bsdf_has_delta(const Surface* s) {
-  return s->roughness <= WP_DELTA_ROUGHNESS;
+  return sqr(s->roughness) < WP_DELTA_ALPHA;
 }
 inline bool bsdf_transmits(const Surface* s) {
 #if WP_FEATURE_TRANSMISSION
@@ -100,6 +110,16 @@ inline float relative_ior(const Surface* s) {
   return bsdf_volume(s) && !(s->flags & WP_SURF_FRONT) ? 1.0f / s->ior : s->ior;
 }
 
+/* A volume interface whose relative index is this close to 1 does not bend light: its
+ * transmission is straight through, a delta lobe at any roughness. (The generalised half vector
+ * wo + eta wi of a rough interface vanishes as eta -> 1: the transmitted lobe's width is
+ * ~ alpha |eta - 1|, and its density ~ 1 / (eta - 1)^2 overflows float32.) Within 1e-3 of 1 the
+ * refracted directions differ from straight by less than 1e-3 alpha radians. */
+#define WP_ETA_STRAIGHT 1e-3f
+inline bool bsdf_straight_through(const Surface* s, float eta) {
+  return !bsdf_volume(s) || fabs(eta - 1.0f) < WP_ETA_STRAIGHT;
+}
+
 /* The dielectric Fresnel reflectance (Schlick) for a wave meeting the interface at cosine cos_o on
  * its side, eta = eta_other / eta_own. From the denser side the cosine of the refracted direction
  * is used, and beyond the critical angle everything is reflected. */
@@ -124,12 +144,35 @@ inline float dielectric_reflectance(const Surface* s, float cos_o, float eta) {
   return s->specular * fresnel_dielectric(cos_o, eta);
 }
 
+/* The colour-valued weights of a microfacet (or of the smooth surface) with wo at cosine c to it:
+ * reflection (metal and dielectric Fresnel) and transmission ((1 - F) of the dielectric layer's
+ * transmitted part). */
+inline float3 microfacet_reflectance(const Surface* s, float c, float eta) {
+  return (1.0f - s->metallic) * dielectric_reflectance(s, c, eta) +
+         s->metallic * schlick3(s->color, c);
+}
+inline float3 microfacet_transmittance(const Surface* s, float c, float eta) {
+  if (!bsdf_transmits(s)) return (float3)(0.0f);
+  return (1.0f - s->metallic) * (1.0f - dielectric_reflectance(s, c, eta)) * s->transmission *
+         s->color;
+}
+
+/* Probability of reflection (against transmission) once a microfacet with wo at cosine c to it
+ * has been chosen: proportional to the luminance of the two weights. Choosing per microfacet, not
+ * with F at the macro normal, keeps transmission through microfacets that are below the critical
+ * angle when the macro surface is beyond it (light leaving rough glass at grazing angles). */
+inline float microfacet_reflect_prob(const Surface* s, float c, float eta) {
+  const float r = luminance(microfacet_reflectance(s, c, eta));
+  const float t = luminance(microfacet_transmittance(s, c, eta));
+  return r + t > 0.0f ? r / (r + t) : 1.0f;
+}
+
 inline Lobes bsdf_lobes(const Surface* s, float cos_o, float eta) {
   const float m = s->metallic, fd = dielectric_reflectance(s, cos_o, eta);
   const float t = bsdf_transmits(s) ? s->transmission : 0.0f;
   const float albedo = luminance(s->color);
-  const float w_spec = (1.0f - m) * fd + m * luminance(schlick3(s->color, cos_o));
-  const float w_trans = (1.0f - m) * (1.0f - fd) * t * albedo;
+  const float w_spec = luminance(microfacet_reflectance(s, cos_o, eta));
+  const float w_trans = luminance(microfacet_transmittance(s, cos_o, eta));
   const float w_diff = (1.0f - m) * (1.0f - fd) * (1.0f - t) * albedo;
   const float total = w_spec + w_trans + w_diff;
   Lobes l = {1.0f, 0.0f, 0.0f};
@@ -156,25 +199,27 @@ inline void eval_reflection(const Surface* s, float3 wo, float3 wi, float eta, L
   e->pdf = l.diff * cosine_hemisphere_pdf(cos_i);
   if (bsdf_has_delta(s)) return;
   const float alpha = sqr(s->roughness);
-  const float n_dot_h = fmax(dot(s->ns, h), 0.0f);
-  const float dv = ggx_d(n_dot_h, alpha) * ggx_visibility(cos_i, cos_o, alpha);
-  e->f += ((1.0f - s->metallic) * fd + s->metallic * schlick3(s->color, v_dot_h)) * dv;
-  e->pdf += l.spec * ggx_reflection_pdf(cos_o, n_dot_h, alpha);
+  const float n_dot_h = fmax(dot(s->ns, h), 0.0f), sin2_h = sin2_between(s->ns, h);
+  const float dv = ggx_d(n_dot_h, sin2_h, alpha) * ggx_visibility(cos_i, cos_o, alpha);
+  e->f += microfacet_reflectance(s, v_dot_h, eta) * dv;
+  e->pdf += (l.spec + l.trans) * microfacet_reflect_prob(s, v_dot_h, eta) *
+            ggx_reflection_pdf(cos_o, n_dot_h, sin2_h, alpha);
 }
 
 /* Rough transmission (wi below the surface); delta transmission has no density. */
 inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta, Lobes l,
                               BsdfEval* e) {
-  const float alpha = sqr(s->roughness);
+  const float alpha = sqr(s->roughness), g = l.spec + l.trans;
   const float cos_o = dot(s->ns, wo), cos_i = dot(s->ns, wi);
-  const float3 tint = (1.0f - s->metallic) * s->transmission * s->color;
   if (!bsdf_volume(s)) { /* thin-walled: the reflection lobe mirrored through the surface */
     const float3 wr = wi - 2.0f * cos_i * s->ns;
     const float3 h = normalize(wo + wr);
-    const float n_dot_h = fmax(dot(s->ns, h), 0.0f);
-    const float fd = dielectric_reflectance(s, fmax(dot(wo, h), 0.0f), eta);
-    e->f = tint * (1.0f - fd) * ggx_d(n_dot_h, alpha) * ggx_visibility(-cos_i, cos_o, alpha);
-    e->pdf = l.trans * ggx_reflection_pdf(cos_o, n_dot_h, alpha);
+    const float n_dot_h = fmax(dot(s->ns, h), 0.0f), sin2_h = sin2_between(s->ns, h);
+    const float o_h = fmax(dot(wo, h), 0.0f);
+    e->f = microfacet_transmittance(s, o_h, eta) * ggx_d(n_dot_h, sin2_h, alpha) *
+           ggx_visibility(-cos_i, cos_o, alpha);
+    e->pdf = g * (1.0f - microfacet_reflect_prob(s, o_h, eta)) *
+             ggx_reflection_pdf(cos_o, n_dot_h, sin2_h, alpha);
     return;
   }
   float3 h = normalize(wo + eta * wi); /* generalised half vector */
@@ -183,12 +228,13 @@ inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta,
   if (!(o_h > 0.0f && i_h < 0.0f)) return; /* microfacet seen from the wrong side */
   const float denom = i_h + o_h / eta;
   const float n_dot_h = dot(s->ns, h);
-  const float d = ggx_d(n_dot_h, alpha);
+  const float d = ggx_d(n_dot_h, sin2_between(s->ns, h), alpha);
   const float g2 = 1.0f / (1.0f + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha));
-  const float fd = dielectric_reflectance(s, o_h, eta);
   const float jacobian = fabs(i_h) / (denom * denom); /* d omega_h / d omega_i */
-  e->f = tint * ((1.0f - fd) * d * g2 * o_h * jacobian / (fabs(cos_i) * cos_o) / (eta * eta));
-  e->pdf = l.trans * ggx_g1(cos_o, alpha) * o_h * d / cos_o * jacobian;
+  e->f = microfacet_transmittance(s, o_h, eta) *
+         (d * g2 * o_h * jacobian / (fabs(cos_i) * cos_o) / (eta * eta));
+  e->pdf = g * (1.0f - microfacet_reflect_prob(s, o_h, eta)) * ggx_g1(cos_o, alpha) * o_h * d /
+           cos_o * jacobian;
 }
 
 inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
@@ -201,41 +247,60 @@ inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
   const bool below = cos_i < 0.0f && dot(s->ng, wi) < 0.0f;
   if (above)
     eval_reflection(s, wo, wi, eta, l, &e);
-  else if (below && l.trans > 0.0f && !bsdf_has_delta(s))
+  else if (below && bsdf_transmits(s) && !bsdf_has_delta(s) &&
+           !(bsdf_volume(s) && bsdf_straight_through(s, eta)))
     eval_transmission(s, wo, wi, eta, l, &e);
   return e;
 }
 
 /* The delta lobes of a smooth surface: mirror reflection, or transmission (refracted with a
- * volume, straight through when thin-walled). */
+ * volume, straight through when thin-walled or index-matched). */
 inline BsdfSample sample_delta(const Surface* s, float3 wo, float cos_o, float eta, Lobes l,
                                bool transmit) {
   BsdfSample r;
-  r.delta = true, r.pdf = 0.0f, r.valid = false;
-  const float fd = dielectric_reflectance(s, cos_o, eta);
+  r.delta = true, r.pdf = 0.0f, r.valid = false, r.eta_scale = 1.0f;
   if (!transmit) {
     r.wi = 2.0f * cos_o * s->ns - wo;
-    r.weight = ((1.0f - s->metallic) * fd + s->metallic * schlick3(s->color, cos_o)) / l.spec;
+    r.weight = microfacet_reflectance(s, cos_o, eta) / l.spec;
     r.valid = dot(r.wi, s->ng) > 0.0f;
     return r;
   }
-  float3 tint = (1.0f - s->metallic) * s->transmission * (1.0f - fd) * s->color / l.trans;
-  if (bsdf_volume(s)) {
+  float3 tint = microfacet_transmittance(s, cos_o, eta) / l.trans;
+  if (!bsdf_straight_through(s, eta)) {
     const float sin2_t = (1.0f - cos_o * cos_o) / (eta * eta);
     const float cos_t = sqrt(fmax(0.0f, 1.0f - sin2_t)); /* l.trans > 0 excludes TIR */
     r.wi = normalize(-wo / eta + (cos_o / eta - cos_t) * s->ns);
-    tint /= eta * eta;
   } else {
     r.wi = -wo;
+  }
+  if (bsdf_volume(s)) { /* radiance changes by 1 / eta^2 across an interface of media */
+    tint /= eta * eta;
+    r.eta_scale = eta * eta;
   }
   r.weight = tint;
   r.valid = dot(r.wi, s->ng) < 0.0f;
   return r;
 }
 
+/* Rough transmission through an index-matched volume interface (bsdf_straight_through): the
+ * direction is -wo whatever the microfacet, a delta lobe. Its weight is the eta -> 1 limit of the
+ * rough one, F at the sampled microfacet and G2 / G1 with wi = -wo: (1 + L) / (1 + 2 L), L the
+ * Smith Lambda of wo. */
+inline BsdfSample sample_straight(const Surface* s, float3 wo, float cos_o, float eta, float o_h,
+                                  float prob) {
+  BsdfSample r;
+  r.delta = true, r.pdf = 0.0f, r.eta_scale = eta * eta;
+  r.wi = -wo;
+  const float lambda = ggx_lambda(cos_o, sqr(s->roughness));
+  r.weight = microfacet_transmittance(s, o_h, eta) *
+             ((1.0f + lambda) / (1.0f + 2.0f * lambda) / (prob * eta * eta));
+  r.valid = dot(r.wi, s->ng) < 0.0f;
+  return r;
+}
+
 inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
   BsdfSample r;
-  r.valid = false, r.delta = false, r.pdf = 0.0f;
+  r.valid = false, r.delta = false, r.pdf = 0.0f, r.eta_scale = 1.0f;
   r.weight = (float3)(0.0f), r.wi = (float3)(0.0f);
   float3 t, b;
   make_basis(s->ns, &t, &b);
@@ -243,19 +308,25 @@ inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 
   if (!(wo_l.z > 0.0f)) return r;
   const float eta = relative_ior(s);
   const Lobes l = bsdf_lobes(s, wo_l.z, eta);
-  const bool spec = u_lobe < l.spec, trans = !spec && u_lobe < l.spec + l.trans;
-  if ((spec || trans) && bsdf_has_delta(s)) return sample_delta(s, wo, wo_l.z, eta, l, trans);
+  const float g = l.spec + l.trans; /* the microfacet lobes */
+  if (u_lobe < g && bsdf_has_delta(s)) return sample_delta(s, wo, wo_l.z, eta, l, u_lobe >= l.spec);
   float3 wi_l;
-  if (spec || trans) {
+  bool trans = false;
+  if (u_lobe < g) {
     const float3 h = sample_ggx_visible_normal(wo_l, sqr(s->roughness), u);
     const float o_h = dot(wo_l, h);
-    wi_l = 2.0f * o_h * h - wo_l; /* reflection about the microfacet */
+    const float p_reflect = microfacet_reflect_prob(s, o_h, eta);
+    trans = u_lobe >= g * p_reflect; /* u_lobe / g is uniform in [0, 1) here */
+    wi_l = 2.0f * o_h * h - wo_l;    /* reflection about the microfacet */
     if (trans && !bsdf_volume(s)) {
       wi_l.z = -wi_l.z; /* thin-walled: mirrored through the surface */
+    } else if (trans && bsdf_straight_through(s, eta)) {
+      return sample_straight(s, wo, wo_l.z, eta, o_h, g * (1.0f - p_reflect));
     } else if (trans) {
       const float sin2_t = (1.0f - o_h * o_h) / (eta * eta);
-      if (sin2_t >= 1.0f) return r; /* total internal reflection at this microfacet */
+      if (sin2_t >= 1.0f) return r; /* cannot happen: p_reflect = 1 there */
       wi_l = -wo_l / eta + (o_h / eta - sqrt(1.0f - sin2_t)) * h;
+      r.eta_scale = eta * eta;
     }
   } else {
     wi_l = sample_cosine_hemisphere(u);

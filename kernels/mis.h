@@ -14,14 +14,18 @@
 
 #include "common.h"
 
+/* Written with the ratio r = p_other / p_own: p^2 / (p^2 + q^2) overflows to inf / inf = NaN for
+ * pdfs above ~1.8e19 (a near-delta lobe or a tiny light seen edge-on reaches that), while
+ * 1 / (1 + r^2) only ever rounds to 1 or 0. */
 inline float mis_weight(float p_own, float p_other) {
   if (!(p_other > 0.0f)) return 1.0f;
+  if (isinf(p_own)) return isinf(p_other) ? 0.5f : 1.0f;
+  const float r = p_other / p_own;
 #if WP_MIS_POWER
-  const float a = p_own * p_own, b = p_other * p_other;
+  return 1.0f / (1.0f + r * r);
 #else
-  const float a = p_own, b = p_other;
+  return 1.0f / (1.0f + r);
 #endif
-  return a / (a + b);
 }
 
 /* Weight of emission that a BSDF-sampled ray found, given the pdf of that sample (0 after a

@@ -37,4 +37,11 @@ inline void queue_push(Queues qs, uint q, uint slot) {
   qs.slots[q * qs.capacity + at] = slot;
 }
 
+/* Counts a NaN or infinite value that a stage drops (it must never happen; the renderer reports
+ * the count and the tests require 0). Every place that drops such a value counts it, so that no
+ * failure is silent. */
+inline void count_nonfinite(Queues qs) {
+  atomic_inc(&qs.counters[WP_COUNTER_NONFINITE]);
+}
+
 #endif /* WP_QUEUES_H */

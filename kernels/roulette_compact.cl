@@ -2,7 +2,8 @@
  * From: WP_QUEUE_SURFACE (paths that sampled a next ray in sample_bsdf).
  * To:   queue_out, the next bounce's ray queue, holding the survivors with their bounce count
  *       incremented. From bounce rr_depth on, a path survives with probability
- *       q = min(1, max throughput component) and its throughput is divided by q (unbiased);
+ *       q = min(1, max throughput component x eta scale) and its throughput is divided by q
+ *       (unbiased);
  *       a path with zero throughput ends. */
 #include "stage.h"
 #include "surface.h"
@@ -11,9 +12,16 @@ __kernel void roulette_compact(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
   uint slot;
   if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
-  float4 beta = paths.throughput[slot];
-  const float m = max3(beta.xyz);
-  if (!(m > 0.0f)) return;
+  const float4 beta = paths.throughput[slot];
+  if (!all(isfinite(beta))) { /* sample_bsdf catches these first; a NaN is never dropped silently */
+    count_nonfinite(queues);
+    return;
+  }
+  if (!(max3(beta.xyz) > 0.0f)) return;
+  /* Survival looks at the throughput without the 1/eta^2 factors of refraction (pbrt-v4's
+   * etaScale): inside glass they would otherwise end paths that are about to leave it, where
+   * the factor is undone. */
+  const float m = max3(beta.xyz) * paths.radiance[slot].w;
   const uint bounce = paths.info[slot].y;
   if (bounce + 1u >= launch.rr_depth && m < 1.0f) {
     if (rng_get(path_rng(paths, slot, launch), WP_DIM_ROULETTE) >= m) return;

@@ -2,7 +2,11 @@
  * From: WP_QUEUE_SURFACE.
  * To:   the next ray of each path (ray_o/ray_d), throughput *= f cos / pdf, the sample's pdf in
  *       throughput.w (0 for a delta lobe) and WP_PATH_DELTA in info.z, kept for MIS at the next
- *       hit. A path with no valid direction gets throughput 0; roulette_compact ends it. */
+ *       hit. A path with no valid direction gets throughput 0; roulette_compact ends it, as it
+ *       does a path whose throughput or pdf would be NaN/Inf (counted, queues.h). A refraction
+ *       into another medium multiplies the eta scale (radiance.w) by eta^2. */
+/* Through a smooth thin-walled transmitter the pdf, the flags and the distance are carried on
+ * (see below). */
 #include "stage.h"
 #include "surface.h"
 
@@ -14,13 +18,29 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   const Rng rng = path_rng(paths, slot, launch);
   const BsdfSample bs = bsdf_sample(&s, -paths.ray_d[slot].xyz, rng_get(rng, WP_DIM_BSDF_LOBE),
                                     rng_get2(rng, WP_DIM_BSDF_U));
-  float4 beta = paths.throughput[slot];
-  if (!bs.valid) {
+  const float4 beta = paths.throughput[slot];
+  const float3 next = beta.xyz * bs.weight;
+  if (bs.valid && !(all(isfinite(next)) && isfinite(bs.pdf))) count_nonfinite(queues);
+  if (!bs.valid || !(all(isfinite(next)) && isfinite(bs.pdf))) {
     paths.throughput[slot] = (float4)(0.0f);
     return;
   }
-  paths.throughput[slot] = (float4)(beta.xyz * bs.weight, bs.pdf);
-  paths.info[slot].z = bs.delta ? WP_PATH_DELTA : 0u;
+  paths.radiance[slot].w *= bs.eta_scale;
+#if WP_FEATURE_TRANSMISSION
+  /* Straight through a smooth thin-walled transmitter, which shadow rays pass too (trace_shadow):
+   * the path goes on along the direction the previous vertex sampled, so it keeps that sample's
+   * pdf and flags for MIS at the next hit, and counts the distance to that vertex (info.w) for the
+   * light's pdf there. */
+  if (bs.delta && !bsdf_volume(&s) && dot(bs.wi, s.ng) < 0.0f) {
+    paths.throughput[slot] = (float4)(next, beta.w);
+    paths.info[slot].w = as_uint(as_float(paths.info[slot].w) + paths.hit[slot].x);
+  } else
+#endif
+  {
+    paths.throughput[slot] = (float4)(next, bs.pdf);
+    paths.info[slot].z = bs.delta ? WP_PATH_DELTA : 0u;
+    paths.info[slot].w = as_uint(0.0f);
+  }
   /* Leave on the side the new direction goes to (below for transmission). */
   paths.ray_o[slot] =
       (float4)(surface_spawn(&s, paths.ray_d[slot].xyz, paths.hit[slot].x, bs.wi), 0.0f);

@@ -25,11 +25,23 @@ inline float cosine_hemisphere_pdf(float cos_theta) {
   return fmax(cos_theta, 0.0f) * WP_INV_PI;
 }
 
-/* GGX (Trowbridge-Reitz) normal distribution D(h) for alpha = roughness^2, local frame. */
-inline float ggx_d(float n_dot_h, float alpha) {
+/* GGX (Trowbridge-Reitz) normal distribution D(h) for alpha = roughness^2, from the cosine and
+ * the squared sine of h's angle to the normal. The textbook denominator cos^2 (alpha^2 - 1) + 1
+ * cancels in float32 for small alpha: alpha^2 below half an ulp of 1 (alpha < 2.4e-4) makes
+ * alpha^2 - 1 exactly -1, and the denominator 1 - cos^2 reaches 0 at h = n (D = inf, then NaN
+ * weights); above that, alpha^2 keeps only a few bits. Written as alpha^2 cos^2 + sin^2, with
+ * sin^2 computed directly (|n x h|^2, or x^2 + y^2 in a local frame), every term is positive and
+ * no bits are lost. Callers keep alpha >= WP_DELTA_ALPHA (bsdf.h), so D stays finite. */
+inline float ggx_d(float cos_h, float sin2_h, float alpha) {
   const float a2 = alpha * alpha;
-  const float k = n_dot_h * n_dot_h * (a2 - 1.0f) + 1.0f;
+  const float k = a2 * cos_h * cos_h + sin2_h;
   return a2 / (WP_PI * k * k);
+}
+
+/* sin^2 of the angle between unit vectors n and h, without the cancellation of 1 - cos^2. */
+inline float sin2_between(float3 n, float3 h) {
+  const float3 c = cross(n, h);
+  return dot(c, c);
 }
 
 /* Smith G1 for GGX. */
@@ -66,9 +78,10 @@ inline float3 sample_ggx_visible_normal(float3 v, float alpha, float2 u) {
 }
 
 /* Density of the reflected direction l = reflect(v, h) when h is sampled as above:
- * D_v(h) / (4 v.h) = G1(v) D(h) / (4 v.z). */
-inline float ggx_reflection_pdf(float n_dot_v, float n_dot_h, float alpha) {
-  return ggx_g1(n_dot_v, alpha) * ggx_d(n_dot_h, alpha) / (4.0f * n_dot_v);
+ * D_v(h) / (4 v.h) = G1(v) D(h) / (4 v.z). h's cosine and squared sine to the normal as in
+ * ggx_d. */
+inline float ggx_reflection_pdf(float n_dot_v, float n_dot_h, float sin2_h, float alpha) {
+  return ggx_g1(n_dot_v, alpha) * ggx_d(n_dot_h, sin2_h, alpha) / (4.0f * n_dot_v);
 }
 
 #endif /* WP_SAMPLING_H */

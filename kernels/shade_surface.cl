@@ -39,7 +39,9 @@ __kernel void shade_surface(WP_STAGE_PARAMS) {
   if (front || (scene.materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) {
     const float3 le = material_emission(&scene, tv, hit.y, hit.z);
     if (max3(le) > 0.0f) {
-      const float p_light = triangle_light_pdf(&scene, tri, hit.x, dot(s.ng, ray_d));
+      /* Seen from the vertex that sampled the ray: panes passed on the way add their distance. */
+      const float dist = hit.x + as_float(paths.info[slot].w);
+      const float p_light = triangle_light_pdf(&scene, tri, dist, dot(s.ng, ray_d));
       paths.radiance[slot].xyz += beta.xyz * le * mis_weight_bsdf_hit(beta.w, p_light);
     }
   }

@@ -250,6 +250,45 @@ INSTANTIATE_TEST_SUITE_P(Lights, RenderPunctual,
                                            LightCase{"SunGlossy", sun_light(), 0.3, 0.6}),
                          [](const auto& param_info) { return std::string(param_info.param.name); });
 
+// The sun through a window: a smooth thin-walled glass pane (transmission 1, ior 1.5, white) at
+// y = 1 over the plane; the camera is below it. Shadow rays pass the pane with its transmittance
+// 1 - F(cos), F = 0.04 + 0.96 (1 - cos)^5 (Schlick, f0 of ior 1.5), cos the sun's angle to the
+// pane: each pixel is f * E cos(theta) * (1 - F). Direct light only (max_depth 1), so light
+// reflected between plane and pane does not add to the closed form. Before shadow rays passed
+// such panes, the plane got nothing of the sun.
+TEST_F(RenderKnown, SunThroughThinGlassPane) {
+  wp::Material floor;
+  floor.base_color = glm::vec4(0.8f, 0.6f, 0.4f, 1.0f);
+  floor.metallic = 0.0f;
+  floor.roughness = 1.0f;
+  wp::Scene s = plane_scene(floor);
+  wp::Material glass;
+  glass.base_color = glm::vec4(1.0f);
+  glass.metallic = 0.0f;
+  glass.roughness = 0.0f;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  glass.double_sided = true;  // single-sided, its back face (toward the plane) would be culled
+  s.materials.push_back(glass);
+  wp::test::add_quad(s, {-100, 1, -100}, {-100, 1, 100}, {100, 1, 100}, {100, 1, -100}, 1);
+  wp::test::finish_bounds(s);
+  const wp::PunctualLight sun = sun_light();
+  s.lights.push_back(sun);
+  const vec3 eye(0.0f, 0.5f, 1.5f);
+  s.cameras.push_back(wp::test::look_at(eye, {0.0f, 0.0f, 0.0f}, 0.8f));
+  wp::RenderSettings st = settings_for(s, vec3(0.0f));
+  st.max_depth = 1;
+  const wp::dev::Camera cam = wp::device_camera(s.cameras[0], kWidth, kHeight);
+  const dvec3 base(0.8, 0.6, 0.4), n(0, 1, 0), wi = -glm::normalize(dvec3(sun.direction));
+  const double fresnel = 0.04 + 0.96 * std::pow(1.0 - wi.y, 5.0);
+  const auto expected = integrate(cam, [&](dvec3 d) {
+    dvec3 p;
+    if (!plane_hit(eye, d, &p)) return dvec3(0.0);
+    return gltf_brdf(n, -d, wi, base, 0.0, 1.0) * wi.y * dvec3(sun.intensity) * (1.0 - fresnel);
+  });
+  expect_matches(wp::render(*runtime_, s, st), expected);
+}
+
 // An emissive quad facing the camera shows its radiance; seen from behind it is not there when
 // single-sided (glTF back-face culling) and emits from both sides when double-sided.
 TEST_F(RenderKnown, EmissionAndSidedness) {

@@ -323,20 +323,25 @@ Config bsdf_config(float metallic, float roughness, float4 color, double view_de
 // A BSDF configuration: check_config, then the lobe choice. A smooth surface (roughness 0) has
 // delta lobes for specular reflection and transmission, chosen with bsdf_lobes' probabilities, so
 // the fractions of delta samples above and below the surface must match them; a rough one has no
-// delta samples. Nothing goes below a surface that does not transmit.
+// delta samples. Nothing goes below a surface that does not transmit, nor below a smooth one past
+// the critical angle.
 void check_bsdf(const Config& c) {
   const Draw d = check_config(c);
   SCOPED_TRACE(c.name);
   const std::vector<float> lobes = Device::get().lobes(c);
   const double n = kSamples, spec = lobes[0], trans = lobes[1];
-  if (c.params.y <= 0.01f) {  // WP_DELTA_ROUGHNESS
+  const bool smooth = c.params.y * c.params.y < 1e-3f;  // WP_DELTA_ALPHA
+  if (smooth) {
     EXPECT_NEAR(static_cast<double>(d.delta - d.delta_below) / n, spec,
                 5.0 * binomial_sigma(spec, n));
     EXPECT_NEAR(static_cast<double>(d.delta_below) / n, trans, 5.0 * binomial_sigma(trans, n));
   } else {
     EXPECT_EQ(d.delta, 0u);
   }
-  if (trans == 0.0) {
+  // A rough surface chooses transmission per microfacet: past the macro critical angle (trans =
+  // 0 at the macro normal) microfacets tilted toward wo still transmit.
+  const bool transmits = c.params.w > 0.0f && c.params.x < 1.0f;
+  if (!transmits || (smooth && trans == 0.0)) {
     EXPECT_EQ(d.below, 0u);
   } else if (trans > 0.01) {
     EXPECT_GT(d.below, 0u);

@@ -48,7 +48,8 @@
 #define WP_QUEUE_SHADOW 3u  /* paths with a pending shadow ray */
 #define WP_QUEUE_COUNT 4u
 /* Counters after the queue counters. */
-#define WP_COUNTER_NONFINITE 4u /* samples the film rejected as NaN/Inf (must stay 0) */
+#define WP_COUNTER_NONFINITE 4u /* NaN/Inf values dropped anywhere (must stay 0): film samples, \
+                                   path throughputs, light-sample contributions */
 #define WP_COUNTER_COUNT 5u
 
 WP_DEV_BEGIN

@@ -107,7 +107,7 @@ inline float config_pdf(const Config* c, const SceneView* scene, float3 l) {
   if (c->routine == ST_COSINE) return cosine_hemisphere_pdf(l.z);
   if (c->routine == ST_GGX) {
     const float3 v = c->a.xyz, h = normalize(v + l);
-    return h.z > 0.0f ? ggx_reflection_pdf(v.z, h.z, c->a.w) : 0.0f;
+    return h.z > 0.0f ? ggx_reflection_pdf(v.z, h.z, h.x * h.x + h.y * h.y, c->a.w) : 0.0f;
   }
   if (c->routine == ST_BSDF) {
     const Surface s = config_surface(c);
@@ -172,7 +172,7 @@ inline void draw_other(const Config* c, const SceneView* scene, float2 u, float4
   } else if (c->routine == ST_GGX) {
     const float3 v = c->a.xyz, h = sample_ggx_visible_normal(v, c->a.w, u);
     l = 2.0f * dot(v, h) * h - v;
-    pdf = ggx_reflection_pdf(v.z, h.z, c->a.w);
+    pdf = ggx_reflection_pdf(v.z, h.z, h.x * h.x + h.y * h.y, c->a.w);
   } else {
     const LightSample ls = sample_triangle(scene, 0u, c->a.xyz, u);
     l = ls.wi;
