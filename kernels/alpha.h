@@ -42,4 +42,18 @@ inline bool alpha_passes(const SceneView* scene, uint tri, float u, float v, uin
   return alpha_random(key, tri) < alpha;
 }
 
+/* The probability that a ray finds triangle `tri` at (u, v): 1 for an opaque material, the cutout
+ * test for MASK, alpha itself for BLEND (the stochastic test above passes with that
+ * probability). Next-event estimation scales an emitter's radiance by it, so that light sampling
+ * and BSDF sampling (whose rays see the emitter only where the traversal accepts it) estimate the
+ * same light. */
+inline float alpha_coverage(const SceneView* scene, uint tri, float u, float v) {
+  __global const Material* m = scene->materials + scene->tri_vertices[tri].w;
+  const uint flags = m->flags.x;
+  if (!(flags & (WP_MAT_ALPHA_MASK | WP_MAT_ALPHA_BLEND))) return 1.0f;
+  const float alpha = material_alpha(scene, tri, u, v);
+  if (flags & WP_MAT_ALPHA_MASK) return alpha >= m->emission.w ? 1.0f : 0.0f;
+  return clamp(alpha, 0.0f, 1.0f);
+}
+
 #endif /* WP_ALPHA_H */

@@ -9,13 +9,15 @@
  * - emissive triangle: a point uniform in its area, pdf 1/A converted to solid angle,
  *   d^2 / (A |cos theta_light|). The emitting side follows the glTF winding: the front face emits,
  *   the back face only when the material is double-sided (the same rule shade_surface applies to
- *   hits);
+ *   hits), and an emitter with alpha (MASK, BLEND) emits only with the probability that a ray
+ *   finds it there (alpha.h, alpha_coverage);
  * - environment: environment.h's sampling, pdf in solid angle.
  * The returned pdf includes the light-choice probability. */
 #ifndef WP_LIGHTS_H
 #define WP_LIGHTS_H
 
 #include "common.h"
+#include "alpha.h"
 #include "environment.h"
 #include "material.h"
 
@@ -105,6 +107,9 @@ inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, f
   s.pdf = triangle_solid_angle_pdf(0.5f * area2, s.dist, cos_light);
   s.target = offset_origin(q, cos_light > 0.0f ? n / area2 : -n / area2, q_scale);
   s.li = material_emission(scene, tv, b1, b2);
+#if WP_FEATURE_ALPHA
+  s.li *= alpha_coverage(scene, tri, b1, b2); /* no light from a cut-out or see-through part */
+#endif
   return s;
 }
 

@@ -244,6 +244,28 @@ INSTANTIATE_TEST_SUITE_P(Sky, StrategiesAgree, ::testing::Values(false, true), [
   return std::string(p.param ? "EnvironmentMap" : "ConstantSky");
 });
 
+// An emitter with alpha: BSDF-sampled rays see it only where the traversal accepts it (MASK: where
+// alpha >= cutoff; BLEND: with probability alpha), so NEE must scale its light by the same
+// coverage. The lamp of the agreement scene as BLEND with alpha 0.5, and as MASK cut out
+// everywhere (alpha 0.2 < cutoff 0.5): NEE and BSDF sampling agree. Before NEE looked at alpha,
+// it lit the scene with the whole lamp in both cases.
+TEST_F(LightTransport, AlphaEmittersAgree) {
+  for (const wp::AlphaMode mode : {wp::AlphaMode::kBlend, wp::AlphaMode::kMask}) {
+    wp::Scene s = agreement_scene();
+    wp::Material& lamp = s.materials[2];
+    ASSERT_GT(lamp.emission.x, 0.0f);
+    lamp.alpha_mode = mode;
+    lamp.base_color.a = mode == wp::AlphaMode::kBlend ? 0.5f : 0.2f;
+    wp::RenderSettings st = agreement_settings();
+    st.strategy = wp::Strategy::kNee;
+    const wp::Rendered nee = render(s, st);
+    st.strategy = wp::Strategy::kBsdf;
+    st.seed = 2;
+    const wp::Rendered bsdf = render(s, st);
+    expect_agree(nee, bsdf, 4, mode == wp::AlphaMode::kBlend ? "blend lamp" : "mask lamp");
+  }
+}
+
 TEST_F(LightTransport, HeuristicsAndLightSelectionAgree) {
   const wp::Scene s = agreement_scene();
   wp::RenderSettings st = agreement_settings();
