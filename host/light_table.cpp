@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "host/emission.h"
 #include "host/error.h"
 
 namespace wp {
@@ -91,8 +92,8 @@ LightTable build_light_table(const Scene& scene, const EnvironmentMap* env, glm:
   t.tri_light.assign(scene.triangle_count(), WP_NO_LIGHT);
   for (std::size_t i = 0; i < scene.triangle_count(); ++i) {
     const Material& m = scene.materials[scene.triangle_material[i]];
-    const double l = luminance(m.emission);
-    if (!(l > 0.0)) continue;
+    const TriangleEmission e = triangle_emission(scene, i);
+    if (e.zero()) continue;  // black everywhere (an emissive texture's dark part): not a light
     const glm::vec3 a = scene.positions[scene.indices[3 * i]];
     const glm::vec3 b = scene.positions[scene.indices[3 * i + 1]];
     const glm::vec3 c = scene.positions[scene.indices[3 * i + 2]];
@@ -103,6 +104,9 @@ LightTable build_light_table(const Scene& scene, const EnvironmentMap* env, glm:
     d.meta.y = static_cast<dev::uint>(i);
     t.tri_light[i] = static_cast<std::uint32_t>(t.lights.size());
     t.lights.push_back(d);
+    // The integrated emission; a triangle whose sampled mean is 0 but whose peak is not (a lit
+    // spot between the grid points) keeps a small chance of being chosen.
+    const double l = std::max(luminance(e.mean), 1e-3 * e.peak);
     power.push_back(kPi * area * l * (m.double_sided ? 2.0 : 1.0));
     ++t.emissive_triangles;
   }

@@ -7,7 +7,8 @@
 //   point: 4 pi I;  spot: 2 pi (1 - cos(mean cone angle)) I;  directional: pi r^2 E;
 //   triangle: pi A L (twice that when double-sided);  environment: 4 pi^2 r^2 L_mean;
 // with luminances of the RGB values, r the radius of the scene's bounding sphere, A the area, L
-// the emitted radiance. The pmf of every light is stored too: MIS needs the probability with which
+// the emitted radiance averaged over the triangle (host/emission.h: an emissive texture is
+// integrated; a triangle that is black everywhere is not a light). The pmf of every light is stored too: MIS needs the probability with which
 // NEE would have chosen a light that a BSDF-sampled ray found.
 #pragma once
 

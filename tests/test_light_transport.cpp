@@ -19,6 +19,7 @@
 #include "host/device_scene.h"
 #include "host/environment.h"
 #include "host/image_io.h"
+#include "host/light_table.h"
 #include "host/render.h"
 #include "tests/scene_factory.h"
 
@@ -264,6 +265,57 @@ TEST_F(LightTransport, AlphaEmittersAgree) {
     const wp::Rendered bsdf = render(s, st);
     expect_agree(nee, bsdf, 4, mode == wp::AlphaMode::kBlend ? "blend lamp" : "mask lamp");
   }
+}
+
+// A lamp with an emissive texture that is black on its left half (host/emission.h): the lamp is
+// an 8 x 8 grid of quads, and the triangles on the black half are no lights at all. Light
+// sampling, BSDF sampling and MIS still agree (a triangle that is not in the light table shows
+// its emission to BSDF-sampled rays with weight 1).
+TEST_F(LightTransport, TexturedLampStrategiesAgree) {
+  wp::Scene s = agreement_scene();
+  const std::size_t lamp_first = s.triangle_count() - 2;  // the agreement scene's lamp: last quad
+  wp::Image img;
+  img.width = img.height = 16;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int c = 0; c < 4; ++c) img.rgba.push_back(c == 3 || x >= 8 ? 255 : 0);
+  s.images.push_back(img);
+  wp::TextureRef t;
+  t.image = 0;
+  t.srgb = true;
+  t.wrap_s = t.wrap_t = wp::Wrap::kClampToEdge;
+  s.textures.push_back(t);
+  s.materials[2].emissive_texture = 0;
+  s.materials[2].emission *= 2.0f;
+  // Replace the lamp quad by a grid over the same rectangle (facing down), uv = its x-z position.
+  s.indices.resize(3 * lamp_first);
+  s.triangle_material.resize(lamp_first);
+  constexpr int kCells = 8;
+  for (int j = 0; j < kCells; ++j)
+    for (int i = 0; i < kCells; ++i) {
+      const float x0 = float(i) / kCells, x1 = float(i + 1) / kCells;
+      const float z0 = -0.6f + float(j) / kCells, z1 = -0.6f + float(j + 1) / kCells;
+      const std::size_t first = s.positions.size();
+      wp::test::add_quad(s, {x0, 1.4f, z0}, {x1, 1.4f, z0}, {x1, 1.4f, z1}, {x0, 1.4f, z1}, 2);
+      for (std::size_t k = first; k < s.positions.size(); ++k)
+        s.uv0[k] = {s.positions[k].x, s.positions[k].z + 0.6f};
+    }
+  wp::test::finish_bounds(s);
+  wp::RenderSettings st = agreement_settings();
+  const wp::LightTable table =
+      wp::build_light_table(s, nullptr, st.background, 1.0f, wp::LightSelect::kPower);
+  EXPECT_EQ(table.emissive_triangles, std::size_t{kCells * kCells + 2 * kCells})
+      << "the lamp's black half (columns 0-2 wholly, by the filter's reach) is no light";
+  st.strategy = wp::Strategy::kMis;
+  const wp::Rendered mis = render(s, st);
+  st.strategy = wp::Strategy::kNee;
+  st.seed = 1;
+  const wp::Rendered nee = render(s, st);
+  st.strategy = wp::Strategy::kBsdf;
+  st.seed = 2;
+  const wp::Rendered bsdf = render(s, st);
+  expect_agree(mis, bsdf, 4, "textured lamp: MIS vs BSDF");
+  expect_agree(nee, bsdf, 4, "textured lamp: NEE vs BSDF");
 }
 
 TEST_F(LightTransport, HeuristicsAndLightSelectionAgree) {
