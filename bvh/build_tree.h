@@ -79,8 +79,8 @@ struct TreeLeaf : TreeNode {
 struct EmbreeTree {
   struct Handles;
   std::unique_ptr<Handles> handles;
-  const TreeNode* root = nullptr;
-  Box scene_bounds{};  // bounds of all input triangles
+  const TreeNode* root = nullptr;  // null for an input without triangles
+  Box scene_bounds{};              // bounds of all input triangles; without any, the origin
 
   EmbreeTree();
   EmbreeTree(EmbreeTree&&) noexcept;
@@ -89,7 +89,9 @@ struct EmbreeTree {
 
 // Validates `input` and `options` (throws wp::Error naming the first problem) and runs Embree's
 // builder with at most options.width children per node. Leaves hold up to options.max_leaf_size
-// references; with options.spatial_splits a triangle may be referenced by several leaves.
+// references; with options.spatial_splits a triangle may be referenced by several leaves. An input
+// without triangles (a valid glTF scene may have none) is not given to Embree: the tree has no
+// root.
 EmbreeTree build_embree_tree(const BuildInput& input, const BuildOptions& options);
 
 // The flatteners: fill out.nodes/triangles (binary; the tree must be binary) or out.nodes8/blocks
@@ -99,6 +101,11 @@ void flatten_binary(const TreeNode& root, const Box& scene, const BuildInput& in
                     const BuildOptions& options, Bvh& out);
 void flatten_wide(const TreeNode& root, const Box& scene, const BuildInput& input,
                   const BuildOptions& options, Bvh& out);
+// The layouts of a tree without a root (no triangles): a root node alone, every child of it empty
+// (binary: both children, count 0 and lo > hi, like the single-leaf root's child 1; wide: all 8
+// slots unused), so that every ray misses. `scene` is the root's box.
+void flatten_empty_binary(const Box& scene, const BuildOptions& options, Bvh& out);
+void flatten_empty_wide(const Box& scene, const BuildOptions& options, Bvh& out);
 
 // The spatial-split clipper: the part of triangle `v` inside `box` is cut by the plane
 // x[dim] = pos, and `left`/`right` receive the bounds of the parts with x[dim] <= pos and

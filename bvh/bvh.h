@@ -63,7 +63,10 @@ struct Bvh {
   BuildStats stats;
 };
 
-// Builds the BVH. Throws wp::Error on failure (e.g. no triangles, Embree error).
+// Builds the BVH. Throws wp::Error on failure (e.g. bad options, Embree error). An input without
+// triangles is valid: its BVH is a root alone whose children are all empty (binary: two leaves of
+// count 0 with lo > hi boxes; wide: 8 unused slots), which every ray misses, with bounds at the
+// origin.
 Bvh build(const BuildInput& input, const BuildOptions& options = {});
 
 // CPU reference traversal of the flattened layout (either width, by bvh.width), with the same
@@ -93,10 +96,12 @@ bool intersect_triangle(const dev::IsectTri& tri, const Ray& ray, float tmax, Hi
 // it; width 8: the exact preorder, children in slot order); inner-node depth <=
 // WP_BVH_MAX_DEPTH / WP_BVH8_MAX_DEPTH; every scene triangle is referenced (exactly once unless
 // `spatial_splits`); without spatial splits, each referenced triangle lies inside its leaf's box.
-// Width 2: leaves of 1..WP_BVH_MAX_LEAF_SIZE triangles. Width 8: used slots first, unused slots
-// (child 0, boxes +INFINITY) last; leaves of 1..WP_BVH8_MAX_LEAF_BLOCKS blocks that no two leaves
-// share, with the unused lanes (all-zero vertices, prim 0xffffffff, flags 0) only at the end
-// of a leaf's last block, which has at least one used lane.
+// Width 2: leaves of 1..WP_BVH_MAX_LEAF_SIZE triangles; empty children (count 0, lo > hi) only in
+// the root: child 1 beside a leaf, or both. Width 8: used slots first, unused slots (child 0,
+// boxes +INFINITY) last, at least 2 used except in the root (1, a leaf, or none); leaves of
+// 1..WP_BVH8_MAX_LEAF_BLOCKS blocks that no two leaves share, with the unused lanes (all-zero
+// vertices, prim 0xffffffff, flags 0) only at the end of a leaf's last block, which has at least
+// one used lane.
 std::string check_invariants(const Bvh& bvh, std::size_t triangle_count, bool spatial_splits);
 
 }  // namespace wp::bvh

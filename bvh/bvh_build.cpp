@@ -25,7 +25,8 @@ float uint_bits_as_float(std::uint32_t u) {
 
 // The empty child's box: lo > hi, as bvh_layout.h asks. Beware that the slab test, which takes
 // min/max of the two slab distances per axis, does not reject an inverted box (it treats it like
-// [-1e30, 1e30]^3); the child is harmless because its triangle count is 0.
+// [-1e30, 1e30]^3); the child is harmless because its triangle count is 0 (its reference ~0 is
+// never followed into the triangle array, which may be empty).
 const Box kEmptyChildBox{glm::vec3(1e30f), glm::vec3(-1e30f)};
 
 void set_child(dev::BvhNode& node, int slot, const Box& b, std::int32_t link, std::int32_t count) {
@@ -79,6 +80,15 @@ class Flattener {
     out_.nodes.push_back(root);
   }
 
+  // A scene without triangles: a root whose two children are both empty.
+  void empty_root(const Box& root_box) {
+    account_inner(root_box, 1);
+    dev::BvhNode root{};
+    set_child(root, 0, kEmptyChildBox, ~0, 0);
+    set_child(root, 1, kEmptyChildBox, ~0, 0);
+    out_.nodes.push_back(root);
+  }
+
  private:
   void account_inner(const Box& box, int depth) {
     stats().inner_nodes++;
@@ -127,6 +137,11 @@ void flatten_binary(const TreeNode& root, const Box& scene, const BuildInput& in
     flattener.inner(static_cast<const TreeInner&>(root), scene, 1);
 }
 
+void flatten_empty_binary(const Box& scene, const BuildOptions& options, Bvh& out) {
+  const BuildInput none;
+  Flattener(none, options, scene, out).empty_root(scene);
+}
+
 }  // namespace detail
 
 Bvh build(const BuildInput& input, const BuildOptions& options) {
@@ -137,7 +152,12 @@ Bvh build(const BuildInput& input, const BuildOptions& options) {
   out.width = options.width;
   out.lo = tree.scene_bounds.lo;
   out.hi = tree.scene_bounds.hi;
-  if (options.width == WP_BVH8_WIDTH)
+  const bool wide = options.width == WP_BVH8_WIDTH;
+  if (!tree.root && wide)
+    detail::flatten_empty_wide(tree.scene_bounds, options, out);
+  else if (!tree.root)
+    detail::flatten_empty_binary(tree.scene_bounds, options, out);
+  else if (wide)
     detail::flatten_wide(*tree.root, tree.scene_bounds, input, options, out);
   else
     detail::flatten_binary(*tree.root, tree.scene_bounds, input, options, out);

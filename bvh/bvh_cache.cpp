@@ -212,6 +212,13 @@ void cache_store(const std::string& dir, std::uint64_t key, const Bvh& b) {
 Bvh build_cached(const BuildInput& input, const BuildOptions& options, const std::string& dir,
                  bool* hit, const std::function<void(const Bvh&)>& accept) {
   const auto start = std::chrono::steady_clock::now();
+  // A scene without triangles builds at once (no Embree): nothing to save by caching it.
+  if (input.triangle_count == 0) {
+    if (hit) *hit = false;
+    Bvh b = build(input, options);
+    if (accept) accept(b);
+    return b;
+  }
   const std::uint64_t key = dir.empty() ? 0 : cache_key(input, options);
   if (std::optional<Bvh> cached = cache_load(dir, key, input.triangle_count, options)) {
     if (hit) *hit = true;

@@ -45,7 +45,8 @@ std::optional<Bvh> cache_load(const std::string& dir, std::uint64_t key, std::si
                               const BuildOptions& options);
 void cache_store(const std::string& dir, std::uint64_t key, const Bvh& bvh);
 
-// bvh::build through the cache in `dir` (empty: no cache). *hit tells whether it was loaded.
+// bvh::build through the cache in `dir` (empty: no cache; a scene without triangles, which builds
+// at once, is never cached). *hit tells whether it was loaded.
 // `accept`, when given, sees a BVH just built before it is stored, and may throw to refuse it
 // (then nothing is stored).
 Bvh build_cached(const BuildInput& input, const BuildOptions& options, const std::string& dir,

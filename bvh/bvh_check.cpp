@@ -82,11 +82,13 @@ class Checker {
     todo.push_back({link, box, p.depth + 1});
   }
 
-  // Only the root of a single-leaf scene has one: child 1, count 0, lo > hi.
+  // Count 0, lo > hi, and only in a root: child 1 beside a leaf (a single-leaf scene), or both
+  // children (a scene without triangles; then the references check finds any triangle missing).
   void empty_child(const Pending& p, int slot, const ChildBox& box) {
     const dev::BvhNode& n = bvh_.nodes[static_cast<std::size_t>(p.node)];
-    if (p.node != 0 || slot != 1 || n.link.x >= 0)
-      return fail(p.node, slot, "empty child outside a single-leaf root");
+    const bool other_empty = slot == 0 ? n.link.y < 0 && n.link.w == 0 : n.link.x < 0;
+    if (p.node != 0 || !(slot == 1 ? n.link.x < 0 : other_empty))
+      return fail(p.node, slot, "empty child outside a single-leaf or empty root");
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] > box.hi[k])) return fail(p.node, slot, "empty child with a non-empty box");
   }

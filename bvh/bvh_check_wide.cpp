@@ -100,9 +100,12 @@ class WideChecker {
       if (n.child.s[slot] != 0) return fail(p.node, slot, "used slot after an unused one");
       if (!unused_box(child_box(n, slot))) return fail(p.node, slot, "unused slot with a box");
     }
-    // Embree makes 2..8 children; only a single-leaf scene has a root with one (a leaf).
+    // Embree makes 2..8 children; only a single-leaf scene has a root with one (a leaf), and only a
+    // scene without triangles one with none (then the references check finds any missing).
     const bool single_leaf_root = p.node == 0 && used == 1 && n.child.s[0] < 0;
-    if (used < 2 && !single_leaf_root) return fail(p.node, used, "fewer than 2 children");
+    const bool empty_root = p.node == 0 && used == 0;
+    if (used < 2 && !single_leaf_root && !empty_root)
+      return fail(p.node, used, "fewer than 2 children");
     const std::size_t first_new = todo.size();
     for (int slot = 0; slot < used && error_.empty(); ++slot) child(p, n, slot, todo);
     std::reverse(todo.begin() + static_cast<std::ptrdiff_t>(first_new), todo.end());

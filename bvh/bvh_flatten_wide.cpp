@@ -87,6 +87,12 @@ class WideFlattener {
     out_.nodes8.push_back(root);
   }
 
+  // A scene without triangles: a root (box `scene`) with every slot unused.
+  void empty_root(const Box& scene) {
+    account_inner(scene, 1);
+    out_.nodes8.push_back(empty_node());
+  }
+
  private:
   // The reference to a child of a node at `depth`: a leaf's block range, or its node index.
   std::int32_t child_ref(const TreeNode& child, const Box& box, int depth) {
@@ -193,6 +199,11 @@ void flatten_wide(const TreeNode& root, const Box& scene, const BuildInput& inpu
     flattener.single_leaf(static_cast<const TreeLeaf&>(root), scene);
   else
     flattener.inner(static_cast<const TreeInner&>(root), scene, 1);
+}
+
+void flatten_empty_wide(const Box& scene, const BuildOptions& options, Bvh& out) {
+  const BuildInput none;
+  WideFlattener(none, options, scene, out).empty_root(scene);
 }
 
 }  // namespace wp::bvh::detail

@@ -175,8 +175,7 @@ int max_leaf_size_for(int width) {
 }
 
 void validate(const BuildInput& input, const BuildOptions& options) {
-  if (input.triangle_count == 0) throw Error("BVH build: the scene has no triangles");
-  if (!input.positions || !input.indices)
+  if (input.triangle_count > 0 && (!input.positions || !input.indices))
     throw Error("BVH build: missing vertex positions or indices");
   if (input.triangle_count > kMaxTriangles)
     throw Error("BVH build: too many triangles (" + std::to_string(input.triangle_count) +
@@ -265,12 +264,16 @@ RTCBuildArguments build_arguments(const BuildOptions& options, bool splits,
 
 EmbreeTree build_embree_tree(const BuildInput& input, const BuildOptions& options) {
   validate(input, options);
-  BuildContext ctx;
-  ctx.input = &input;
   EmbreeTree tree;
   tree.handles = std::make_unique<EmbreeTree::Handles>();
-
   const std::size_t n = input.triangle_count;
+  if (n == 0) {  // nothing for Embree to build: no root, and bounds at the origin
+    tree.scene_bounds = Box{glm::vec3(0.0f), glm::vec3(0.0f)};
+    return tree;
+  }
+  BuildContext ctx;
+  ctx.input = &input;
+
   double total_area = 0;
   // Spare capacity only for spatial splits; Embree rejects splits of zero-area boxes anyway (and
   // its split budget divides by the total area), so a scene of such boxes builds without them.

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numeric>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "host/emission.h"
@@ -84,7 +85,9 @@ LightTable build_light_table(const Scene& scene, const EnvironmentMap* env, glm:
                              float env_intensity, LightSelect select) {
   LightTable t;
   std::vector<double> power;
-  const double radius = 0.5 * glm::length(scene.bounds_hi - scene.bounds_lo);
+  // The scene's bounding radius; 0 for inverted bounds (a scene without triangles built in code).
+  const glm::vec3 extent = glm::max(scene.bounds_hi - scene.bounds_lo, glm::vec3(0.0f));
+  const double radius = 0.5 * glm::length(extent);
   for (const PunctualLight& l : scene.lights) {
     t.lights.push_back(punctual(l));
     power.push_back(punctual_power(l, radius));

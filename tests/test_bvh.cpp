@@ -4,6 +4,8 @@
 // triangle test and Embree's own rtcIntersect1/rtcOccluded1.
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -93,6 +95,59 @@ TEST(BvhBuild, SingleTriangleIsARootWithOneLeafAndAnEmptyChild) {
   EXPECT_EQ(bvh.hi, glm::vec3(1, 1, 0.5f));
 }
 
+// A scene without triangles (valid glTF: no nodes, only a camera, only lines) builds without
+// Embree: a root alone whose two children are empty (count 0, lo > hi), as the single-leaf root's
+// child 1. Its options are still checked.
+TEST(BvhBuild, EmptyInputIsARootWithTwoEmptyChildren) {
+  for (const bool splits : {false, true}) {
+    BuildOptions o;
+    o.spatial_splits = splits;
+    const Bvh bvh = build(BuildInput{}, o);
+    EXPECT_EQ(bvh.width, 2);
+    EXPECT_EQ(check_invariants(bvh, 0, splits), "");
+    ASSERT_EQ(bvh.nodes.size(), 1u);
+    EXPECT_TRUE(bvh.triangles.empty() && bvh.nodes8.empty() && bvh.blocks.empty());
+    const dev::BvhNode& root = bvh.nodes[0];
+    EXPECT_LT(root.link.x, 0);
+    EXPECT_LT(root.link.y, 0);
+    EXPECT_EQ(root.link.z, 0);
+    EXPECT_EQ(root.link.w, 0);
+    EXPECT_GT(root.c0_xy.x, root.c0_xy.y);  // empty boxes: lo > hi
+    EXPECT_GT(root.c1_xy.x, root.c1_xy.y);
+    EXPECT_GT(root.c01_z.x, root.c01_z.y);
+    EXPECT_GT(root.c01_z.z, root.c01_z.w);
+    EXPECT_EQ(bvh.stats.inner_nodes, 1u);
+    EXPECT_EQ(bvh.stats.leaves, 0u);
+    EXPECT_EQ(bvh.stats.triangle_refs, 0u);
+    EXPECT_EQ(bvh.stats.max_depth, 1);
+    EXPECT_TRUE(std::isfinite(bvh.stats.sah_cost) && bvh.stats.sah_cost > 0);
+    // The checks still tell it from a BVH that lost its triangles.
+    EXPECT_NE(check_invariants(bvh, 1, splits), "");
+  }
+  BuildOptions bad;
+  bad.max_leaf_size = 0;
+  EXPECT_THROW(build(BuildInput{}, bad), Error);
+  bad = {};
+  bad.width = 3;
+  EXPECT_THROW(build(BuildInput{}, bad), Error);
+}
+
+// Only a root may have empty children, and child 0 only when child 1 is empty too (the empty
+// scene's root).
+TEST(BvhBuild, EmptyChildOnlyAtTheRoot) {
+  Mesh m;
+  m.add({0, 0, 0}, {1, 0, 0}, {0, 1, 0.5f});
+  Bvh bvh = build(m.input());
+  ASSERT_EQ(check_invariants(bvh, 1, false), "");
+  std::swap(bvh.nodes[0].c0_xy, bvh.nodes[0].c1_xy);  // the leaf as child 1, the empty as child 0
+  std::swap(bvh.nodes[0].link.x, bvh.nodes[0].link.y);
+  std::swap(bvh.nodes[0].link.z, bvh.nodes[0].link.w);
+  const float z[4] = {bvh.nodes[0].c01_z.z, bvh.nodes[0].c01_z.w, bvh.nodes[0].c01_z.x,
+                      bvh.nodes[0].c01_z.y};
+  bvh.nodes[0].c01_z = {z[0], z[1], z[2], z[3]};
+  EXPECT_NE(check_invariants(bvh, 1, false), "");
+}
+
 TEST(BvhBuild, StoredTrianglesAreTheVerticesWithIndexAndFlags) {
   Mesh m = sphere(16, 32);
   for (std::size_t i = 0; i < m.triangles(); ++i) m.flags.push_back(std::uint32_t(i % 3 == 0));
@@ -158,7 +213,6 @@ TEST(BvhBuild, ClipperBoundsTheTrianglePieceNotJustTheBox) {
 TEST(BvhBuild, BadInputThrows) {
   Mesh m = soup(10, 1, 0.1f);
   BuildOptions o;
-  EXPECT_THROW(build(BuildInput{m.positions.data(), m.indices.data(), 0, nullptr}), Error);
   EXPECT_THROW(build(BuildInput{nullptr, m.indices.data(), m.triangles(), nullptr}), Error);
   for (const int leaf : {0, -1, WP_BVH_MAX_LEAF_SIZE + 1}) {
     o.max_leaf_size = leaf;
@@ -180,6 +234,27 @@ TEST(BvhBuild, BadInputThrows) {
 
 // ---------------------------------------------------------------------------------------------
 // Traversal
+
+// Every ray misses the empty scene's BVH: from anywhere, in any direction (the axis-aligned
+// positive ones with tmax = +INFINITY included), whatever its tmax.
+TEST(BvhTraverse, EmptyInputMissesEveryRay) {
+  const Bvh bvh = build(BuildInput{});
+  std::mt19937 rng(7);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 2000; ++i) {
+    const float tmax = i % 3 == 0 ? kInf : i % 3 == 1 ? 1e30f : 5.0f;
+    const glm::vec3 o = i % 2 ? glm::vec3(0.0f) : random_in(rng, -10.0f, 10.0f);
+    rays.push_back({o, random_direction(rng), 0.0f, tmax});
+  }
+  for (const glm::vec3 d : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1),
+                            glm::normalize(glm::vec3(1, 1, 1))})
+    for (const glm::vec3 o : {glm::vec3(-5.0f), glm::vec3(0.0f), glm::vec3(1e30f)})
+      rays.push_back({o, d, 0.0f, kInf});
+  for (const Ray& ray : rays) {
+    EXPECT_FALSE(intersect_closest(bvh, ray).hit);
+    EXPECT_FALSE(occluded(bvh, ray));
+  }
+}
 
 TEST(BvhTraverse, MatchesEmbree) {
   BuildOptions splits;

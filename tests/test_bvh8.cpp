@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -132,6 +133,48 @@ TEST(Bvh8Build, SingleTriangleIsARootWithOneLeafAndSevenUnusedSlots) {
   EXPECT_EQ(bvh.stats.max_depth, 1);
   EXPECT_EQ(bvh.stats.leaves, 1u);
   EXPECT_DOUBLE_EQ(bvh.stats.sah_cost, 2.0);  // the root, plus one block over the whole scene
+}
+
+// A scene without triangles builds without Embree: a root alone with all 8 slots unused (child 0,
+// boxes +INFINITY) and no blocks.
+TEST(Bvh8Build, EmptyInputIsARootWithEightUnusedSlots) {
+  for (const bool splits : {false, true}) {
+    const Bvh bvh = build(BuildInput{}, wide(WP_BVH_MAX_LEAF_SIZE, splits));
+    EXPECT_EQ(bvh.width, 8);
+    EXPECT_EQ(check_invariants(bvh, 0, splits), "");
+    ASSERT_EQ(bvh.nodes8.size(), 1u);
+    EXPECT_TRUE(bvh.blocks.empty() && bvh.nodes.empty() && bvh.triangles.empty());
+    const dev::BvhNode8& root = bvh.nodes8[0];
+    for (int i = 0; i < 8; ++i) {
+      EXPECT_EQ(root.child.s[i], 0);
+      for (const float f : {root.lo_x.s[i], root.hi_x.s[i], root.lo_y.s[i], root.hi_y.s[i],
+                            root.lo_z.s[i], root.hi_z.s[i]})
+        EXPECT_EQ(f, kInf);
+    }
+    EXPECT_EQ(bvh.stats.inner_nodes, 1u);
+    EXPECT_EQ(bvh.stats.leaves, 0u);
+    EXPECT_EQ(bvh.stats.triangle_refs, 0u);
+    EXPECT_EQ(bvh.stats.max_depth, 1);
+    EXPECT_TRUE(std::isfinite(bvh.stats.sah_cost) && bvh.stats.sah_cost > 0);
+    EXPECT_NE(check_invariants(bvh, 1, splits), "");  // a BVH that lost its triangles
+  }
+  EXPECT_THROW(build(BuildInput{}, wide(4 * WP_BVH8_MAX_LEAF_BLOCKS + 1)), Error);
+}
+
+// Only the empty scene's root has no used slot.
+TEST(Bvh8Build, ChildlessNodeOnlyAsTheEmptySceneRoot) {
+  const Mesh m = soup(9, 3, 0.05f);
+  Bvh bvh = build(m.input(), wide(1));
+  ASSERT_EQ(check_invariants(bvh, m.triangles(), false), "");
+  ASSERT_GT(bvh.nodes8.size(), 1u);
+  // Node 1 is an inner child of the root; leave it with no children.
+  const float inf = kInf;
+  dev::BvhNode8& n = bvh.nodes8[1];
+  for (int i = 0; i < 8; ++i) {
+    n.child.s[i] = 0;
+    n.lo_x.s[i] = n.hi_x.s[i] = n.lo_y.s[i] = n.hi_y.s[i] = n.lo_z.s[i] = n.hi_z.s[i] = inf;
+  }
+  EXPECT_NE(check_invariants(bvh, m.triangles(), false), "");
 }
 
 TEST(Bvh8Build, BlockLanesAreTheVerticesWithIndexAndFlags) {
@@ -381,6 +424,27 @@ TEST(Bvh8Traverse, MatchesTheBinaryReference) {
       }
     }
     EXPECT_LT(double(cmp.ties()), 1e-3 * double(cmp.rays()));
+  }
+}
+
+// Every ray misses the empty scene's wide BVH, the ones that enter its unused slots' +INFINITY
+// boxes (tmax = +INFINITY, no negative direction component) included.
+TEST(Bvh8Traverse, EmptyInputMissesEveryRay) {
+  const Bvh bvh = build(BuildInput{}, wide());
+  std::mt19937 rng(7);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 2000; ++i) {
+    const float tmax = i % 3 == 0 ? kInf : i % 3 == 1 ? 1e30f : 5.0f;
+    const glm::vec3 o = i % 2 ? glm::vec3(0.0f) : random_in(rng, -10.0f, 10.0f);
+    rays.push_back({o, random_direction(rng), 0.0f, tmax});
+  }
+  for (const glm::vec3 d : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1),
+                            glm::normalize(glm::vec3(1, 1, 1))})
+    for (const glm::vec3 o : {glm::vec3(-5.0f), glm::vec3(0.0f), glm::vec3(1e30f)})
+      rays.push_back({o, d, 0.0f, kInf});
+  for (const Ray& ray : rays) {
+    EXPECT_FALSE(intersect_closest(bvh, ray).hit);
+    EXPECT_FALSE(occluded(bvh, ray));
   }
 }
 

@@ -245,6 +245,23 @@ TEST_F(Cli, FailedRunOverwritesNothing) {
   EXPECT_EQ(slurp(dir_ / "keep.exr"), "old");
 }
 
+// A glTF scene without triangles is valid: it renders the background alone, and exits 0.
+TEST_F(Cli, EmptySceneRendersTheBackground) {
+  std::ofstream(dir_ / "scene.gltf")
+      << R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})";
+  const CliRun r = run(
+      "render scene.gltf --width 8 --height 6 --spp 1 -o out.exr --env-color 0.25,0.5,1 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir_ / "out.exr"));
+  const wp::ImageRgb img = wp::read_exr((dir_ / "out.exr").string());
+  ASSERT_EQ(img.width, 8);
+  ASSERT_EQ(img.height, 6);
+  const float background[3] = {0.25f, 0.5f, 1.0f};
+  for (std::size_t i = 0; i < img.rgb.size(); ++i)
+    ASSERT_EQ(img.rgb[i], background[i % 3]) << "value " << i;
+  EXPECT_NE(r.out.find("\"triangles\":0"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, RendersBothImagesWithSettingsAndJson) {
   const CliRun r = run("render '" + cornell() + "' --spp 2 --width 32 --height 24 --seed 5 --json");
   ASSERT_EQ(r.status, 0) << r.err;

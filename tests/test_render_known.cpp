@@ -316,6 +316,30 @@ TEST_F(RenderKnown, EmissionAndSidedness) {
   }
 }
 
+// A scene without triangles (valid glTF: no nodes, or only a camera) shows the background and
+// nothing else: every camera ray escapes, so every pixel is the background radiance exactly, with
+// both BVH layouts; its lights have nothing to light.
+TEST_F(RenderKnown, EmptySceneShowsOnlyTheBackground) {
+  wp::Scene s;
+  s.lights.push_back(point_light());
+  s.lights.push_back(sun_light());
+  wp::test::finish_bounds(s);  // no positions: the bounds stay inverted
+  s.cameras.push_back(wp::test::look_at({0.0f, 1.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.9f));
+  const vec3 background(0.25f, 0.5f, 1.0f);
+  for (const int width : {2, 8}) {
+    wp::RenderSettings st = settings_for(s, background);
+    st.bvh_width = width;
+    st.spp = 4;
+    const wp::Rendered r = wp::render(*runtime_, s, st);
+    EXPECT_EQ(r.report.triangles, 0u);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    ASSERT_EQ(r.image.rgb.size(), std::size_t(3 * kWidth * kHeight));
+    for (std::size_t p = 0; p < r.image.rgb.size() / 3; ++p)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(r.image.rgb[3 * p + c], background[c]) << "width " << width << " pixel " << p;
+  }
+}
+
 // A small closed scene with every kind of randomness: diffuse, glossy and mirror surfaces, a
 // point light, emission, roulette.
 wp::Scene busy_scene() {

@@ -5,8 +5,9 @@
  *   >= 0 : index of an inner node,
  *   <  0 : a leaf; ~ref is the index of its first triangle in the reordered triangle array and
  *          link.z (child 0) / link.w (child 1) its triangle count (1..WP_BVH_MAX_LEAF_SIZE).
- * An empty child (only in a root whose scene is a single leaf) is a leaf with count 0: rays may
- * enter its (inverted, lo > hi) box, but it holds no triangle to test.
+ * An empty child (only in a root: beside the leaf of a scene that is a single leaf, or both
+ * children of a scene without triangles) is a leaf with count 0: rays may enter its (inverted,
+ * lo > hi) box, but it holds no triangle to test.
  *
  * Triangles are reordered so that every leaf's triangles are contiguous. Each is stored as its
  * three world-space vertices, exactly as the scene gives them, for the watertight test: triangles
