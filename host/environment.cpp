@@ -48,7 +48,7 @@ std::string lower_extension(const std::string& path) {
 // hi * 256 + lo = W, then each of the 4 channels in turn as runs (count > 128: count - 128 copies
 // of the next byte) and literals (count 1..128: that many bytes). Any other scanline is W flat
 // RGBE pixels. Old-style runs (pixel 1, 1, 1, n) are read as pixels, as stb_image did.
-constexpr std::uint64_t kMaxHdrPixels = std::uint64_t{1} << 28;  // 4 GiB of texels
+constexpr std::uint64_t kMaxMapPixels = std::uint64_t{1} << 28;  // 4 GiB of texels (any format)
 
 class RgbeReader {
  public:
@@ -102,7 +102,7 @@ class RgbeReader {
     if (!format) fail("no FORMAT=32-bit_rle_rgbe line in the header");
   }
 
-  // "-Y H +X W" with 0 < W * H <= kMaxHdrPixels; checked before anything is allocated.
+  // "-Y H +X W" with 0 < W * H <= kMaxMapPixels; checked before anything is allocated.
   std::pair<int, int> read_resolution() {
     const std::string line = next_line("resolution line");
     const auto number = [&](std::size_t& at) {
@@ -120,7 +120,7 @@ class RgbeReader {
                        at == line.size();
     if (!shape)
       fail("resolution line '" + line.substr(0, 64) + "' is not '-Y <height> +X <width>'");
-    if (w > kMaxHdrPixels || h > kMaxHdrPixels || w * h > kMaxHdrPixels)
+    if (w > kMaxMapPixels || h > kMaxMapPixels || w * h > kMaxMapPixels)
       fail(std::to_string(w) + " x " + std::to_string(h) + " pixels is more than the 2^28 read");
     // Cheapest possible scanline: 4 flat bytes a pixel, or 4 + 4 channels x 2 bytes a run of 127.
     const std::uint64_t least = std::min<std::uint64_t>(4 * w, 4 + 8 * ((w + 126) / 127));
@@ -198,6 +198,20 @@ void read_exr(const std::string& path, EnvironmentMap& env) {
     const Imath::Box2i dw = header.dataWindow();
     const long long w = 1LL + dw.max.x - dw.min.x, h = 1LL + dw.max.y - dw.min.y;
     if (w <= 0 || h <= 0) throw Error(path + ": the image is empty");
+    // Checked before allocating: a 417-byte file can declare a 2^28-pixel window (found by
+    // tests/fuzz). Besides the texel limit of .hdr maps, the file must be able to hold the
+    // window: at 6 bytes per pixel (half RGB), no EXR compression (zlib: at most ~1000:1) packs
+    // more than 2048 x its size, and maps up to 16 MiB of pixels are never refused on this count.
+    const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
+    const std::uint64_t file_bytes = std::filesystem::file_size(path);
+    if (std::uint64_t(w) > kMaxMapPixels || std::uint64_t(h) > kMaxMapPixels ||
+        pixels > kMaxMapPixels)
+      throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
+                  " pixels is more than the 2^28 read");
+    if (6 * pixels > 2048 * file_bytes + (std::uint64_t{16} << 20))
+      throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
+                  " pixels in a file of " + std::to_string(file_bytes) +
+                  " bytes: the EXR header is corrupt");
     env.width = static_cast<int>(w);
     env.height = static_cast<int>(h);
     env.texels.assign(std::size_t(w) * std::size_t(h), glm::vec4(0.0f));

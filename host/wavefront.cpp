@@ -76,9 +76,17 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
     counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
     film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, 2 * pixels * sizeof(dev::float4));
-    rt_.queue().enqueueFillBuffer(counters_, dev::uint(0), 0, WP_COUNTER_COUNT * sizeof(dev::uint));
-    rt_.queue().enqueueFillBuffer(film_, dev::float4{0, 0, 0, 0}, 0,
-                                  2 * pixels * sizeof(dev::float4));
+    // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
+    // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every
+    // host write, sized to that write, so a fill (stored one pattern at a time) or a partial write
+    // leaves the entire buffer "uninitialised" to its --uninitialized check. The counters are 20
+    // bytes; the film's host zeros are as large as the copy image() reads back, and made once.
+    const std::vector<dev::uint> zero_counters(WP_COUNTER_COUNT, 0u);
+    rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, zero_counters.size() * sizeof(dev::uint),
+                                   zero_counters.data());
+    const std::vector<dev::float4> zero_film(2 * pixels, dev::float4{0, 0, 0, 0});
+    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, zero_film.size() * sizeof(dev::float4),
+                                   zero_film.data());
   } catch (const cl::Error& e) {
     rethrow_cl(e, "allocating device memory on " + rt_.device().name);
   }
@@ -139,11 +147,6 @@ cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch&
   return event;
 }
 
-void Wavefront::reset_counters(std::uint32_t first, std::uint32_t count) {
-  rt_.queue().enqueueFillBuffer(counters_, dev::uint(0), first * sizeof(dev::uint),
-                                count * sizeof(dev::uint));
-}
-
 std::uint32_t Wavefront::read_counter(std::uint32_t index) {
   dev::uint value = 0;
   rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, index * sizeof(dev::uint), sizeof(value),
@@ -194,8 +197,15 @@ dev::Launch Wavefront::start_wave(std::uint32_t sample, std::uint32_t first_pixe
 }
 
 std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
-  reset_counters(WP_QUEUE_SURFACE, 2);  // surface and shadow queues
-  reset_counters(p.queue_out, 1);
+  // Empty the surface, shadow and output queues. One write of all queue counters from offset 0,
+  // with queue_in's rewritten to the `rays` it already holds, rather than fills of the three: any
+  // partial host write makes Oclgrind 21.10 treat the whole counter buffer as uninitialised (see
+  // the constructor). The nonfinite counter after them is not written: it persists (so Oclgrind
+  // would call it uninitialised, were count_nonfinite ever reached; it must not be).
+  std::array<dev::uint, WP_QUEUE_COUNT> counters{};
+  counters[p.queue_in] = rays;
+  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
+                                 counters.data());
   launch(Stage::kIntersectClosest, rays, p);
   launch(Stage::kShadeSurface, rays, p);
   launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots

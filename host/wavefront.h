@@ -130,7 +130,6 @@ class Wavefront {
  private:
   void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count);
   cl::Event launch(Stage stage, std::uint32_t items, const dev::Launch& params);
-  void reset_counters(std::uint32_t first, std::uint32_t count);
   std::uint32_t read_counter(std::uint32_t index);
   void collect_profile();
   void prime_kernels();

@@ -12,6 +12,7 @@
 #include <functional>
 #include <future>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <random>
 
@@ -168,6 +169,54 @@ TEST(EnvironmentLoad, ExrDataWindow) {
     for (int x = 0; x < 6; ++x)
       for (int c = 0; c < 3; ++c)
         EXPECT_EQ(env.texels[std::size_t(y * 6 + x)][c], value(x, y, c)) << x << " " << y;
+}
+
+// An EXR whose header declares a data window far larger than the file holds, in the form the
+// fuzzer found (tests/fuzz): a 6 x 2 RGB float image, one scanline per chunk (RLE), whose
+// dataWindow attribute (box2i xMin, yMin, xMax, yMax, little-endian int32) is then patched to a
+// wide x range; OpenEXR opens it, and the loader used to allocate width x 2 x 16 bytes (4 GiB
+// for 2^28 texels, 537 MB for 2^25) before reading failed. Refused now before any allocation.
+void write_wide_exr(const std::string& path, std::int32_t x_min, std::int32_t x_max) {
+  {
+    Imf::Header header(6, 2);
+    header.compression() = Imf::RLE_COMPRESSION;
+    for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    std::vector<float> px(6 * 2 * 3, 1.0f);
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c)
+      fb.insert(std::string(1, "RGB"[c]),
+                Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(px.data() + c), 12, 72));
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(2);
+  }
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t box = at + key.size() + 4;  // after the attribute's size field
+  f.clear();
+  f.seekp(static_cast<std::streamoff>(box));
+  f.write(reinterpret_cast<const char*>(&x_min), 4);
+  f.seekp(static_cast<std::streamoff>(box + 8));
+  f.write(reinterpret_cast<const char*>(&x_max), 4);
+}
+
+TEST(EnvironmentLoad, ExrHugeDataWindowIsAnError) {
+  for (const auto& [x_min, x_max] :
+       {std::pair<std::int32_t, std::int32_t>{-(1 << 26), 1 << 26}, {-(1 << 24), 2}}) {
+    const std::string path = temp_file("huge_window.exr");
+    write_wide_exr(path, x_min, x_max);
+    try {
+      wp::load_environment(path);
+      ADD_FAILURE() << "window columns " << x_min << ".." << x_max << " accepted";
+    } catch (const wp::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("pixels"), std::string::npos) << e.what();
+      std::cout << "  refused: " << e.what() << "\n";
+    }
+    std::filesystem::remove(path);
+  }
 }
 
 void expect_refused(const std::string& path, const std::string& why) {

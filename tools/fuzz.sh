@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# Builds the fuzz targets (tests/fuzz/, clang++ with libFuzzer, AddressSanitizer and
+# UndefinedBehaviorSanitizer) in build-fuzz/ and runs each for SECONDS (default 60):
+#   fuzz_gltf         wp::load_gltf on .gltf / .glb bytes
+#   fuzz_environment  wp::load_environment on .hdr (and .exr) bytes
+# Seeds: tests/fuzz/make_seeds.py's built-in ones, plus small models and cropped .hdr maps from
+# ../shared/assets (WAVEPATH_ASSETS overrides) when that folder exists. The corpus each run grows
+# is kept in build-fuzz/corpus/<target>/, so later runs start where earlier ones stopped.
+#
+# Exits non-zero when a target reports a finding (a crash, a sanitizer report, an exception other
+# than wp::Error, a broken scene invariant, a hang over 10 s, a leak, over 2 GiB of memory): the
+# input is saved in build-fuzz/findings/<target>/ and printed with the log's tail. Replay one with
+#   build-fuzz/fuzz_gltf build-fuzz/findings/fuzz_gltf/crash-...
+# (WP_FUZZ_VERBOSE=1 prints the wp::Error an input gives).
+#
+#   tools/fuzz.sh [SECONDS]   build if needed, fuzz each target SECONDS
+#   tools/fuzz.sh --check     exit 0 when clang++ can build libFuzzer targets, else 1 (silent)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+have_libfuzzer() {
+  command -v clang++ >/dev/null 2>&1 || return 1
+  local dir
+  dir=$(mktemp -d)
+  printf 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }\n' \
+    >"$dir/probe.cpp"
+  clang++ -fsanitize=fuzzer,address,undefined "$dir/probe.cpp" -o "$dir/probe" >/dev/null 2>&1
+  local status=$?
+  rm -rf "$dir"
+  return $status
+}
+
+if [[ ${1:-} == --check ]]; then
+  if have_libfuzzer; then exit 0; fi
+  exit 1
+fi
+seconds=${1:-60}
+if ! [[ $seconds =~ ^[0-9]+$ ]] || ((seconds == 0)); then
+  echo "usage: tools/fuzz.sh [SECONDS] | --check" >&2
+  exit 2
+fi
+if ! have_libfuzzer; then
+  echo "wavepath fuzz: clang++ with libFuzzer is missing (apt-get install clang libclang-rt-14-dev)" >&2
+  exit 1
+fi
+
+build=build-fuzz
+assets=${WAVEPATH_ASSETS:-../shared/assets}
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S tests/fuzz -B "$build" -DCMAKE_CXX_COMPILER=clang++ >/dev/null
+cmake --build "$build" -j"$jobs" >/dev/null
+rm -rf "$build/seeds"
+python3 tests/fuzz/make_seeds.py "$build/seeds" "$assets"
+
+# Each input is written to a file for the loaders; on tmpfs when possible, removed at the end.
+scratch=$(mktemp -d "$([[ -d /dev/shm ]] && echo /dev/shm || echo /tmp)/wavepath-fuzz.XXXXXX")
+trap 'rm -rf "$scratch"' EXIT
+export WP_FUZZ_SCRATCH=$scratch
+
+# fuzz TARGET SEEDS DICT MAX_LEN: one run; returns libFuzzer's status (0: no finding).
+fuzz() {
+  local target=$1 seeds=$2 dict=$3 max_len=$4
+  local corpus="$build/corpus/$target" findings="$build/findings/$target"
+  local log="$build/logs/$target.log"
+  mkdir -p "$corpus" "$findings" "$build/logs"
+  echo "wavepath fuzz: $target for ${seconds}s (log: $log)"
+  local status=0
+  "$build/$target" "$corpus" "$build/seeds/$seeds" -dict="tests/fuzz/$dict" \
+    -max_len="$max_len" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -detect_leaks=1 -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1 ||
+    status=$?
+  grep -E '^stat::(number_of_executed_units|peak_rss_mb)|^Done [0-9]+ runs' "$log" |
+    sed 's/^/  /' || true
+  if ((status != 0)); then
+    echo "wavepath fuzz: $target FOUND A PROBLEM (exit status $status); the log's tail:" >&2
+    grep -v '^#[0-9]' "$log" | tail -n 40 >&2
+    grep -E 'Test unit written to|^artifact_prefix' "$log" | sed 's/^/  /' >&2 || true
+  fi
+  return $status
+}
+
+failed=0
+fuzz fuzz_gltf gltf gltf.dict 65536 || failed=1
+fuzz fuzz_environment environment environment.dict 16384 || failed=1
+if ((failed)); then
+  echo "wavepath fuzz: findings saved under $build/findings/" >&2
+  exit 1
+fi
+echo "wavepath fuzz: no findings"
