@@ -29,7 +29,7 @@ using glm::dvec3;
 using glm::vec3;
 
 class LightTransport : public ::testing::Test {
- protected:
+ public:  // render is used by the free helpers below too
   static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
   static void TearDownTestSuite() {
     delete runtime_;
@@ -85,6 +85,22 @@ void expect_agree(const wp::Rendered& a, const wp::Rendered& b, int block, const
   ASSERT_GT(z.n, 50) << what;
   EXPECT_NEAR(z.mean_z2, 1.0, 5.0 * std::sqrt(2.0 / z.n)) << what << ", worst |z| " << z.worst;
   EXPECT_LT(z.worst, 6.0) << what;
+}
+
+// Renders s with MIS, NEE alone and BSDF sampling alone (different seeds) and expects every pair
+// to agree within their standard errors, over 4 x 4 pixel blocks.
+void expect_strategies_agree(const wp::Scene& s, wp::RenderSettings st, const std::string& what) {
+  const wp::Strategy strategies[3] = {wp::Strategy::kMis, wp::Strategy::kNee, wp::Strategy::kBsdf};
+  const char* names[3] = {"MIS", "NEE", "BSDF"};
+  std::vector<wp::Rendered> r;
+  for (int k = 0; k < 3; ++k) {
+    st.strategy = strategies[k];
+    st.seed = static_cast<std::uint32_t>(k);
+    r.push_back(LightTransport::render(s, st));
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int b = a + 1; b < 3; ++b)
+      expect_agree(r[a], r[b], 4, (what + names[a] + " vs " + names[b]).c_str());
 }
 
 wp::Material glass(bool volume) {
@@ -228,17 +244,7 @@ TEST_P(StrategiesAgree, MisNeeAndBsdf) {
   const wp::Scene s = agreement_scene();
   wp::RenderSettings st = agreement_settings();
   if (GetParam()) st.environment = test_sky();
-  st.strategy = wp::Strategy::kMis;
-  const wp::Rendered mis = render(s, st);
-  st.strategy = wp::Strategy::kNee;
-  st.seed = 1;
-  const wp::Rendered nee = render(s, st);
-  st.strategy = wp::Strategy::kBsdf;
-  st.seed = 2;
-  const wp::Rendered bsdf = render(s, st);
-  expect_agree(mis, nee, 4, "MIS vs NEE");
-  expect_agree(mis, bsdf, 4, "MIS vs BSDF");
-  expect_agree(nee, bsdf, 4, "NEE vs BSDF");
+  expect_strategies_agree(s, st, "");
 }
 
 INSTANTIATE_TEST_SUITE_P(Sky, StrategiesAgree, ::testing::Values(false, true), [](const auto& p) {
@@ -306,16 +312,7 @@ TEST_F(LightTransport, TexturedLampStrategiesAgree) {
       wp::build_light_table(s, nullptr, st.background, 1.0f, wp::LightSelect::kPower);
   EXPECT_EQ(table.emissive_triangles, std::size_t{kCells * kCells + 2 * kCells})
       << "the lamp's black half (columns 0-2 wholly, by the filter's reach) is no light";
-  st.strategy = wp::Strategy::kMis;
-  const wp::Rendered mis = render(s, st);
-  st.strategy = wp::Strategy::kNee;
-  st.seed = 1;
-  const wp::Rendered nee = render(s, st);
-  st.strategy = wp::Strategy::kBsdf;
-  st.seed = 2;
-  const wp::Rendered bsdf = render(s, st);
-  expect_agree(mis, bsdf, 4, "textured lamp: MIS vs BSDF");
-  expect_agree(nee, bsdf, 4, "textured lamp: NEE vs BSDF");
+  expect_strategies_agree(s, st, "textured lamp: ");
 }
 
 TEST_F(LightTransport, HeuristicsAndLightSelectionAgree) {
