@@ -96,6 +96,7 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   }
   r.render_seconds = since(passes_start);
   r.nonfinite_samples = wavefront.nonfinite_samples();
+  r.rays = wavefront.rays_traced();
   r.stages = wavefront.stage_times();
   FilmImages film = wavefront.image(static_cast<std::uint32_t>(settings.spp));
   out.image = {settings.width, settings.height, std::move(film.mean)};

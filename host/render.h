@@ -19,7 +19,7 @@ struct RenderReport {
   std::string features;       // the kernel features the program was built with
   std::string build_options;  // the program's build options
   std::size_t triangles = 0;
-  bvh::BuildStats bvh;   // build_seconds: of the build, or of the cache look-up when cached
+  bvh::BuildStats bvh;      // build_seconds: of the build, or of the cache look-up when cached
   bool bvh_cached = false;  // loaded from the BVH cache (bvh/bvh_cache.h)
   double kernel_build_seconds = 0;  // includes the OpenCL implementation's cache lookup
   std::size_t kernel_binary_bytes = 0;
@@ -27,6 +27,7 @@ struct RenderReport {
   double render_seconds = 0;      // sample passes, wall clock
   double first_pass_seconds = 0;  // from the call to the end of the first pass
   std::uint64_t nonfinite_samples = 0;
+  std::uint64_t rays = 0;  // closest-hit rays traced (camera and bounce rays; not shadow rays)
   std::size_t wave_size = 0;
   std::size_t bytes_per_path = 0;
   StageTimes stages;  // with RenderSettings::profile
@@ -36,7 +37,7 @@ struct RenderReport {
 };
 
 struct RenderOptions {
-  bvh::BuildOptions bvh;  // the width is set per device (bvh_width)
+  bvh::BuildOptions bvh;   // the width is set per device (bvh_width)
   bool bvh_cache = false;  // look the BVH up in, and store it to, bvh::cache_dir()
   // Called after each sample pass with (passes done, passes in all, seconds since the start).
   std::function<void(int, int, double)> progress;

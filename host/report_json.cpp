@@ -81,7 +81,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"setup_seconds\":" << num(r.setup_seconds)
     << ",\"first_pass_seconds\":" << num(r.first_pass_seconds)
     << ",\"load_seconds\":" << num(load_seconds) << ",\"total_seconds\":" << num(total_seconds)
-    << ",\"nonfinite_samples\":" << r.nonfinite_samples
+    << ",\"nonfinite_samples\":" << r.nonfinite_samples << ",\"rays\":" << r.rays
     << ",\"features\":" << json_string(r.features) << ",\"wave_size\":" << r.wave_size
     << ",\"bytes_per_path\":" << r.bytes_per_path << ",\"outputs\":[";
   for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);

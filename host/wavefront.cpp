@@ -182,7 +182,10 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
 // One wave of paths through all bounces: the algorithm, one named call per stage.
 void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count) {
   dev::Launch p = start_wave(sample, first_pixel, count);
-  for (std::uint32_t rays = count; rays > 0;) rays = run_bounce(p, rays);
+  for (std::uint32_t rays = count; rays > 0;) {
+    rays_traced_ += rays;
+    rays = run_bounce(p, rays);
+  }
   launch(Stage::kAccumulate, count, p);
 }
 

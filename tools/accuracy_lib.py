@@ -36,7 +36,7 @@ REFERENCE_SEED = 987654321  # never used for the runs compared with a reference
 # A configuration is a strategy with optional settings: "mis", "nee", "bsdf", then any of
 # "+heuristic=power|balance", "+select=power|uniform", "+rr=off|N" (Russian roulette after N
 # scattering events; off: none), "+depth=N" (--max-depth). Unset settings are wavepath's defaults
-# (power heuristic, power light selection, roulette after 3, max depth 12).
+# (power heuristic, power light selection, roulette after 5, max depth 12).
 
 DEFAULT_CONFIGS = ("mis", "nee", "bsdf", "mis+heuristic=balance", "mis+select=uniform",
                    "mis+rr=off", "mis+rr=1")

@@ -76,7 +76,7 @@ smallest time; configurations within 10% of it are listed as ties (timing noise 
 Configurations: STRATEGY[+key=value...], STRATEGY one of mis, nee, bsdf; keys heuristic=power|
 balance (--mis-heuristic), select=power|uniform (--light-select), rr=off|N (--no-rr or
 --rr-depth N), depth=N (--max-depth). Unset keys are wavepath's defaults (power heuristic, power
-light selection, roulette after 3 events, max depth 12).
+light selection, roulette after 5 events, max depth 12).
 """
 
 EXAMPLES = """\
