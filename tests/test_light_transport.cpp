@@ -315,6 +315,24 @@ TEST_F(LightTransport, TexturedLampStrategiesAgree) {
   expect_strategies_agree(s, st, "textured lamp: ");
 }
 
+// A smooth thin glass pane (double-sided, transmission 1, ior 1.5) between the lamp and the floor
+// of the agreement scene: NEE's shadow rays pass it with (1 - F) (trace_shadow.cl), BSDF-sampled
+// paths pass it as a delta transmission that keeps the previous vertex's pdf and distance for
+// MIS (sample_bsdf.cl). The three strategies agree only if both sides weigh the light behind the
+// pane alike: with a pane that blocked shadow rays, or a BSDF path that lost its pdf there, NEE
+// or MIS would miss or double the lamp's light on the floor.
+TEST_F(LightTransport, StrategiesAgreeThroughThinGlass) {
+  wp::Scene s = agreement_scene();
+  wp::Material pane = glass(/*volume=*/false);
+  pane.double_sided = true;
+  s.materials.push_back(pane);
+  const auto material = static_cast<std::uint32_t>(s.materials.size() - 1);
+  wp::test::add_quad(s, {-1.2f, 1.1f, -1.5f}, {-1.2f, 1.1f, 1.5f}, {0.6f, 1.1f, 1.5f},
+                     {0.6f, 1.1f, -1.5f}, material);
+  wp::test::finish_bounds(s);
+  expect_strategies_agree(s, agreement_settings(), "through a pane: ");
+}
+
 TEST_F(LightTransport, HeuristicsAndLightSelectionAgree) {
   const wp::Scene s = agreement_scene();
   wp::RenderSettings st = agreement_settings();
