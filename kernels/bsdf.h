@@ -75,7 +75,7 @@ typedef struct BsdfSample {
 
 /* Lobe selection probabilities; they sum to 1. spec + trans is the probability of the
  * microfacet lobes together (reflection and transmission share one sampled microfacet normal and
- * choose between them per microfacet, microfacet_reflect_prob); spec and trans apart are the
+ * choose between them per microfacet, reflect_prob); spec and trans apart are the
  * split at the macro normal, which is the split of a smooth surface's delta lobes. */
 typedef struct Lobes {
   float spec, trans, diff;
@@ -144,36 +144,38 @@ inline float dielectric_reflectance(const Surface* s, float cos_o, float eta) {
   return s->specular * fresnel_dielectric(cos_o, eta);
 }
 
-/* The colour-valued weights of a microfacet (or of the smooth surface) with wo at cosine c to it:
- * reflection (metal and dielectric Fresnel) and transmission ((1 - F) of the dielectric layer's
- * transmitted part). */
-inline float3 microfacet_reflectance(const Surface* s, float c, float eta) {
-  return (1.0f - s->metallic) * dielectric_reflectance(s, c, eta) +
-         s->metallic * schlick3(s->color, c);
-}
-inline float3 microfacet_transmittance(const Surface* s, float c, float eta) {
-  if (!bsdf_transmits(s)) return (float3)(0.0f);
-  return (1.0f - s->metallic) * (1.0f - dielectric_reflectance(s, c, eta)) * s->transmission *
-         s->color;
+/* The weights of a microfacet (or of the smooth surface) with wo at cosine c to it: the
+ * dielectric layer's Fresnel term fd, the colour-valued reflection (metal and dielectric Fresnel)
+ * and transmission ((1 - fd) of the dielectric layer's transmitted part). One Fresnel evaluation
+ * serves all three. */
+typedef struct MicrofacetWeights {
+  float3 reflect, transmit;
+  float fd;
+} MicrofacetWeights;
+
+inline MicrofacetWeights microfacet_weights(const Surface* s, float c, float eta) {
+  MicrofacetWeights w;
+  w.fd = dielectric_reflectance(s, c, eta);
+  w.reflect = (1.0f - s->metallic) * w.fd + s->metallic * schlick3(s->color, c);
+  w.transmit = bsdf_transmits(s) ? (1.0f - s->metallic) * (1.0f - w.fd) * s->transmission * s->color
+                                 : (float3)(0.0f);
+  return w;
 }
 
-/* Probability of reflection (against transmission) once a microfacet with wo at cosine c to it
- * has been chosen: proportional to the luminance of the two weights. Choosing per microfacet, not
- * with F at the macro normal, keeps transmission through microfacets that are below the critical
- * angle when the macro surface is beyond it (light leaving rough glass at grazing angles). */
-inline float microfacet_reflect_prob(const Surface* s, float c, float eta) {
-  const float r = luminance(microfacet_reflectance(s, c, eta));
-  const float t = luminance(microfacet_transmittance(s, c, eta));
+/* Probability of reflection (against transmission) once a microfacet has been chosen:
+ * proportional to the luminance of its two weights. Choosing per microfacet, not with F at the
+ * macro normal, keeps transmission through microfacets that are below the critical angle when the
+ * macro surface is beyond it (light leaving rough glass at grazing angles). */
+inline float reflect_prob(MicrofacetWeights w) {
+  const float r = luminance(w.reflect), t = luminance(w.transmit);
   return r + t > 0.0f ? r / (r + t) : 1.0f;
 }
 
 inline Lobes bsdf_lobes(const Surface* s, float cos_o, float eta) {
-  const float m = s->metallic, fd = dielectric_reflectance(s, cos_o, eta);
+  const MicrofacetWeights w = microfacet_weights(s, cos_o, eta);
   const float t = bsdf_transmits(s) ? s->transmission : 0.0f;
-  const float albedo = luminance(s->color);
-  const float w_spec = luminance(microfacet_reflectance(s, cos_o, eta));
-  const float w_trans = luminance(microfacet_transmittance(s, cos_o, eta));
-  const float w_diff = (1.0f - m) * (1.0f - fd) * (1.0f - t) * albedo;
+  const float w_spec = luminance(w.reflect), w_trans = luminance(w.transmit);
+  const float w_diff = (1.0f - s->metallic) * (1.0f - w.fd) * (1.0f - t) * luminance(s->color);
   const float total = w_spec + w_trans + w_diff;
   Lobes l = {1.0f, 0.0f, 0.0f};
   if (total > 0.0f) l.spec = w_spec / total, l.trans = w_trans / total, l.diff = w_diff / total;
@@ -193,17 +195,17 @@ inline void eval_reflection(const Surface* s, float3 wo, float3 wi, float eta, L
   const float cos_i = dot(s->ns, wi), cos_o = dot(s->ns, wo);
   const float3 h = normalize(wo + wi);
   const float v_dot_h = fmax(dot(wo, h), 0.0f);
-  const float fd = dielectric_reflectance(s, v_dot_h, eta);
+  const MicrofacetWeights w = microfacet_weights(s, v_dot_h, eta);
   const float t = bsdf_transmits(s) ? s->transmission : 0.0f;
-  e->f = (1.0f - s->metallic) * (1.0f - fd) * (1.0f - t) * WP_INV_PI * s->color;
+  e->f = (1.0f - s->metallic) * (1.0f - w.fd) * (1.0f - t) * WP_INV_PI * s->color;
   e->pdf = l.diff * cosine_hemisphere_pdf(cos_i);
   if (bsdf_has_delta(s)) return;
   const float alpha = sqr(s->roughness);
   const float n_dot_h = fmax(dot(s->ns, h), 0.0f), sin2_h = sin2_between(s->ns, h);
   const float dv = ggx_d(n_dot_h, sin2_h, alpha) * ggx_visibility(cos_i, cos_o, alpha);
-  e->f += microfacet_reflectance(s, v_dot_h, eta) * dv;
-  e->pdf += (l.spec + l.trans) * microfacet_reflect_prob(s, v_dot_h, eta) *
-            ggx_reflection_pdf(cos_o, n_dot_h, sin2_h, alpha);
+  e->f += w.reflect * dv;
+  e->pdf +=
+      (l.spec + l.trans) * reflect_prob(w) * ggx_reflection_pdf(cos_o, n_dot_h, sin2_h, alpha);
 }
 
 /* Rough transmission (wi below the surface); delta transmission has no density. */
@@ -215,11 +217,9 @@ inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta,
     const float3 wr = wi - 2.0f * cos_i * s->ns;
     const float3 h = normalize(wo + wr);
     const float n_dot_h = fmax(dot(s->ns, h), 0.0f), sin2_h = sin2_between(s->ns, h);
-    const float o_h = fmax(dot(wo, h), 0.0f);
-    e->f = microfacet_transmittance(s, o_h, eta) * ggx_d(n_dot_h, sin2_h, alpha) *
-           ggx_visibility(-cos_i, cos_o, alpha);
-    e->pdf = g * (1.0f - microfacet_reflect_prob(s, o_h, eta)) *
-             ggx_reflection_pdf(cos_o, n_dot_h, sin2_h, alpha);
+    const MicrofacetWeights w = microfacet_weights(s, fmax(dot(wo, h), 0.0f), eta);
+    e->f = w.transmit * ggx_d(n_dot_h, sin2_h, alpha) * ggx_visibility(-cos_i, cos_o, alpha);
+    e->pdf = g * (1.0f - reflect_prob(w)) * ggx_reflection_pdf(cos_o, n_dot_h, sin2_h, alpha);
     return;
   }
   float3 h = normalize(wo + eta * wi); /* generalised half vector */
@@ -231,10 +231,9 @@ inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta,
   const float d = ggx_d(n_dot_h, sin2_between(s->ns, h), alpha);
   const float g2 = 1.0f / (1.0f + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha));
   const float jacobian = fabs(i_h) / (denom * denom); /* d omega_h / d omega_i */
-  e->f = microfacet_transmittance(s, o_h, eta) *
-         (d * g2 * o_h * jacobian / (fabs(cos_i) * cos_o) / (eta * eta));
-  e->pdf = g * (1.0f - microfacet_reflect_prob(s, o_h, eta)) * ggx_g1(cos_o, alpha) * o_h * d /
-           cos_o * jacobian;
+  const MicrofacetWeights w = microfacet_weights(s, o_h, eta);
+  e->f = w.transmit * (d * g2 * o_h * jacobian / (fabs(cos_i) * cos_o) / (eta * eta));
+  e->pdf = g * (1.0f - reflect_prob(w)) * ggx_g1(cos_o, alpha) * o_h * d / cos_o * jacobian;
 }
 
 inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
@@ -261,11 +260,11 @@ inline BsdfSample sample_delta(const Surface* s, float3 wo, float cos_o, float e
   r.delta = true, r.pdf = 0.0f, r.valid = false, r.eta_scale = 1.0f;
   if (!transmit) {
     r.wi = 2.0f * cos_o * s->ns - wo;
-    r.weight = microfacet_reflectance(s, cos_o, eta) / l.spec;
+    r.weight = microfacet_weights(s, cos_o, eta).reflect / l.spec;
     r.valid = dot(r.wi, s->ng) > 0.0f;
     return r;
   }
-  float3 tint = microfacet_transmittance(s, cos_o, eta) / l.trans;
+  float3 tint = microfacet_weights(s, cos_o, eta).transmit / l.trans;
   if (!bsdf_straight_through(s, eta)) {
     const float sin2_t = (1.0f - cos_o * cos_o) / (eta * eta);
     const float cos_t = sqrt(fmax(0.0f, 1.0f - sin2_t)); /* l.trans > 0 excludes TIR */
@@ -292,7 +291,7 @@ inline BsdfSample sample_straight(const Surface* s, float3 wo, float cos_o, floa
   r.delta = true, r.pdf = 0.0f, r.eta_scale = eta * eta;
   r.wi = -wo;
   const float lambda = ggx_lambda(cos_o, sqr(s->roughness));
-  r.weight = microfacet_transmittance(s, o_h, eta) *
+  r.weight = microfacet_weights(s, o_h, eta).transmit *
              ((1.0f + lambda) / (1.0f + 2.0f * lambda) / (prob * eta * eta));
   r.valid = dot(r.wi, s->ng) < 0.0f;
   return r;
@@ -315,7 +314,7 @@ inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 
   if (u_lobe < g) {
     const float3 h = sample_ggx_visible_normal(wo_l, sqr(s->roughness), u);
     const float o_h = dot(wo_l, h);
-    const float p_reflect = microfacet_reflect_prob(s, o_h, eta);
+    const float p_reflect = reflect_prob(microfacet_weights(s, o_h, eta));
     trans = u_lobe >= g * p_reflect; /* u_lobe / g is uniform in [0, 1) here */
     wi_l = 2.0f * o_h * h - wo_l;    /* reflection about the microfacet */
     if (trans && !bsdf_volume(s)) {

@@ -20,8 +20,9 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
                                     rng_get2(rng, WP_DIM_BSDF_U));
   const float4 beta = paths.throughput[slot];
   const float3 next = beta.xyz * bs.weight;
-  if (bs.valid && !(all(isfinite(next)) && isfinite(bs.pdf))) count_nonfinite(queues);
-  if (!bs.valid || !(all(isfinite(next)) && isfinite(bs.pdf))) {
+  const bool finite = all(isfinite(next)) && isfinite(bs.pdf);
+  if (bs.valid && !finite) count_nonfinite(queues);
+  if (!bs.valid || !finite) {
     paths.throughput[slot] = (float4)(0.0f);
     return;
   }

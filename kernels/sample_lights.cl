@@ -23,8 +23,11 @@ __kernel void sample_lights(WP_STAGE_PARAMS) {
   const BsdfEval e = bsdf_eval(&s, -paths.ray_d[slot].xyz, ls.wi);
   const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
   const float3 c = paths.throughput[slot].xyz * e.f * ls.li * (fabs(dot(s.ns, ls.wi)) * w / ls.pdf);
-  if (!all(isfinite(c))) count_nonfinite(queues);
-  if (!(max3(c) > 0.0f) || !all(isfinite(c))) return;
+  if (!all(isfinite(c))) {
+    count_nonfinite(queues);
+    return;
+  }
+  if (!(max3(c) > 0.0f)) return;
   /* The shadow ray leaves the side of the surface the light is on (transmission can light the
    * back) and, for a light at a finite distance, runs from the moved origin to the light's target
    * point (itself moved off an area light's surface): neither end can hit the surface it is on. */

@@ -6,7 +6,7 @@
  * Without transmission in the program a shadow ray is an any-hit query: any surface occludes.
  * With it, smooth thin-walled transmitters (delta transmission that does not bend the ray, like
  * a window pane) let the ray pass with their transmittance (1 - F) x transmission x base colour
- * (bsdf.h, microfacet_transmittance), so that punctual lights and the sun shine through them as
+ * (bsdf.h, microfacet_weights), so that punctual lights and the sun shine through them as
  * they do in reality; BSDF sampling keeps its pdf through the same surfaces (sample_bsdf.cl), so
  * the MIS weights of both strategies still sum to 1. Such rays go from surface to surface with
  * closest-hit queries, at most WP_SHADOW_MAX_LAYERS panes; a ray that meets more is taken as
@@ -42,7 +42,7 @@ __kernel void trace_shadow(WP_STAGE_PARAMS) {
     if (layer == WP_SHADOW_MAX_LAYERS || !bsdf_has_delta(&s) || !bsdf_transmits(&s) ||
         bsdf_volume(&s))
       return; /* an occluder */
-    transmit *= microfacet_transmittance(&s, fabs(dot(s.ns, d)), relative_ior(&s));
+    transmit *= microfacet_weights(&s, fabs(dot(s.ns, d)), relative_ior(&s)).transmit;
     if (!(max3(transmit) > 0.0f)) return;
     origin = offset_origin(s.p, -s.ng, s.p_scale); /* s.ng faces the incoming ray */
     if (finite) tmax = dot(target - origin, d);

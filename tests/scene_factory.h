@@ -128,6 +128,19 @@ inline Material diffuse_material(glm::vec3 color, bool double_sided = true) {
   return m;
 }
 
+// Smooth white glass: transmission 1, ior 1.5; with `volume` it bounds a volume (thickness 1, no
+// absorption), else it is thin-walled.
+inline Material glass_material(bool volume) {
+  Material m;
+  m.base_color = glm::vec4(1.0f);
+  m.metallic = 0.0f;
+  m.roughness = 0.0f;
+  m.transmission = 1.0f;
+  m.ior = 1.5f;
+  m.thickness = volume ? 1.0f : 0.0f;
+  return m;
+}
+
 inline void finish_bounds(Scene& scene) {
   scene.bounds_lo = glm::vec3(1e30f);
   scene.bounds_hi = glm::vec3(-1e30f);

@@ -73,12 +73,28 @@ class BvhCache : public ::testing::Test {
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
     return fs::directory_iterator(dir_)->path();
   }
+  // An empty cache, then `mesh` stored with `o`: the entry's path, key and bytes.
+  struct Entry {
+    fs::path path;
+    std::uint64_t key;
+    std::vector<char> bytes;
+  };
+  Entry fresh_entry(const Mesh& mesh, const BuildOptions& o);
   std::string dir_;
 };
 
 std::vector<char> read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+BvhCache::Entry BvhCache::fresh_entry(const Mesh& mesh, const BuildOptions& o) {
+  fs::remove_all(dir_);
+  Entry e;
+  e.path = store(mesh, o);
+  e.key = cache_key(mesh.input(), o);
+  e.bytes = read_bytes(e.path);
+  return e;
 }
 
 // Replaces the file with the first n bytes. Removed first: truncating a file in place makes some
@@ -162,11 +178,8 @@ TEST_F(BvhCache, SoundEntryLoadsAsBuilt) {
 TEST_F(BvhCache, FlippedByteIsAMiss) {
   const Mesh mesh = soup(500, 7, 0.05f);
   for (int width : {2, 8}) {
-    fs::remove_all(dir_);
     const BuildOptions o = options(width);
-    const fs::path entry = store(mesh, o);
-    const std::uint64_t key = cache_key(mesh.input(), o);
-    const std::vector<char> good = read_bytes(entry);
+    const auto [entry, key, good] = fresh_entry(mesh, o);
     const Bvh built = build(mesh.input(), o);
     const std::size_t node_bytes = width == 2 ? built.nodes.size() * sizeof(built.nodes[0])
                                               : built.nodes8.size() * sizeof(built.nodes8[0]);
@@ -203,11 +216,8 @@ TEST_F(BvhCache, FlippedByteIsAMiss) {
 TEST_F(BvhCache, HugeLengthIsAMissWithoutABigAllocation) {
   const Mesh mesh = soup(500, 7, 0.05f);
   for (int width : {2, 8}) {
-    fs::remove_all(dir_);
     const BuildOptions o = options(width);
-    const fs::path entry = store(mesh, o);
-    const std::uint64_t key = cache_key(mesh.input(), o);
-    const std::vector<char> good = read_bytes(entry);
+    const auto [entry, key, good] = fresh_entry(mesh, o);
     const std::uint64_t huge[] = {std::uint64_t(1) << 31,       std::uint64_t(1) << 32,
                                   (std::uint64_t(1) << 32) - 1, std::uint64_t(1) << 40,
                                   ~std::uint64_t(0) >> 1,       ~std::uint64_t(0)};
@@ -234,11 +244,8 @@ TEST_F(BvhCache, HugeLengthIsAMissWithoutABigAllocation) {
 TEST_F(BvhCache, TruncatedEntryIsAMiss) {
   const Mesh mesh = soup(500, 7, 0.05f);
   for (int width : {2, 8}) {
-    fs::remove_all(dir_);
     const BuildOptions o = options(width);
-    const fs::path entry = store(mesh, o);
-    const std::uint64_t key = cache_key(mesh.input(), o);
-    const std::vector<char> good = read_bytes(entry);
+    const auto [entry, key, good] = fresh_entry(mesh, o);
     std::vector<std::size_t> lengths;
     for (std::size_t n = 0; n <= sizeof(CacheHeader) + 16; ++n) lengths.push_back(n);
     for (std::size_t n = sizeof(CacheHeader); n < good.size(); n += 97) lengths.push_back(n);

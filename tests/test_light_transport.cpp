@@ -103,17 +103,6 @@ void expect_strategies_agree(const wp::Scene& s, wp::RenderSettings st, const st
       expect_agree(r[a], r[b], 4, (what + names[a] + " vs " + names[b]).c_str());
 }
 
-wp::Material glass(bool volume) {
-  wp::Material m;
-  m.base_color = glm::vec4(1.0f);
-  m.metallic = 0.0f;
-  m.roughness = 0.0f;
-  m.transmission = 1.0f;
-  m.ior = 1.5f;
-  m.thickness = volume ? 1.0f : 0.0f;
-  return m;
-}
-
 struct FurnaceCase {
   const char* name;
   bool cube, volume;
@@ -137,7 +126,7 @@ class Furnace : public LightTransport, public ::testing::WithParamInterface<Furn
 TEST_P(Furnace, SmoothGlassIsInvisible) {
   const FurnaceCase& fc = GetParam();
   wp::Scene s;
-  s.materials.push_back(glass(fc.volume));
+  s.materials.push_back(wp::test::glass_material(fc.volume));
   if (fc.cube)
     wp::test::add_cube(s, {0, 0, 0}, 0.7f, 0.6f, 0);
   else
@@ -323,7 +312,7 @@ TEST_F(LightTransport, TexturedLampStrategiesAgree) {
 // or MIS would miss or double the lamp's light on the floor.
 TEST_F(LightTransport, StrategiesAgreeThroughThinGlass) {
   wp::Scene s = agreement_scene();
-  wp::Material pane = glass(/*volume=*/false);
+  wp::Material pane = wp::test::glass_material(/*volume=*/false);
   pane.double_sided = true;
   s.materials.push_back(pane);
   const auto material = static_cast<std::uint32_t>(s.materials.size() - 1);

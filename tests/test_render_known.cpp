@@ -262,12 +262,7 @@ TEST_F(RenderKnown, SunThroughThinGlassPane) {
   floor.metallic = 0.0f;
   floor.roughness = 1.0f;
   wp::Scene s = plane_scene(floor);
-  wp::Material glass;
-  glass.base_color = glm::vec4(1.0f);
-  glass.metallic = 0.0f;
-  glass.roughness = 0.0f;
-  glass.transmission = 1.0f;
-  glass.ior = 1.5f;
+  wp::Material glass = wp::test::glass_material(/*volume=*/false);
   glass.double_sided = true;  // single-sided, its back face (toward the plane) would be culled
   s.materials.push_back(glass);
   wp::test::add_quad(s, {-100, 1, -100}, {-100, 1, 100}, {100, 1, 100}, {100, 1, -100}, 1);
