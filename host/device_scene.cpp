@@ -1,9 +1,11 @@
 #include "host/device_scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
-#include <iterator>
+#include <string>
 
 #include <glm/geometric.hpp>
 
@@ -20,29 +22,51 @@ dev::float4 f4(glm::vec4 v) {
   return {v.x, v.y, v.z, v.w};
 }
 
-// Every array starts at a 64-byte boundary and must end within reach of a 32-bit offset; an empty
-// one still takes 16 bytes. pack_scene and packed_end both place arrays with these.
-constexpr std::uint64_t kMaxEnd = 0xffffffffu;
+// Every array starts at a 64-byte boundary of its buffer; an empty one still takes 16 bytes (a
+// buffer is never empty). pack_scene and scene_layout both place arrays with these.
 std::uint64_t aligned(std::uint64_t end) {
-  return (end + 63) & ~std::uint64_t(63);
+  return (end + WP_SCENE_ALIGN - 1) & ~std::uint64_t(WP_SCENE_ALIGN - 1);
 }
 std::uint64_t padded(std::uint64_t size) {
   return std::max<std::uint64_t>(size, 16);
 }
-[[noreturn]] void too_large() {
-  throw Error("scene too large for 32-bit buffer offsets");
+
+std::string too_many_texels() {
+  return "scene too large for the device: more than 2^32 texels in its images";
 }
 
-// Appends `items` at the next 64-byte boundary and returns its offset.
-template <class T>
-dev::uint append(std::vector<unsigned char>& bytes, const std::vector<T>& items) {
-  const std::size_t offset = aligned(bytes.size());
-  const std::size_t size = items.size() * sizeof(T);
-  if (offset + size > kMaxEnd) too_large();
-  bytes.resize(offset + padded(size));
-  if (size) std::memcpy(bytes.data() + offset, items.data(), size);
-  return static_cast<dev::uint>(offset);
+// "2.50 GiB", "3.2 MiB" or "900 bytes".
+std::string human_bytes(std::uint64_t bytes) {
+  char text[48];
+  if (bytes >= (1ull << 30))
+    std::snprintf(text, sizeof(text), "%.2f GiB", double(bytes) / double(1ull << 30));
+  else if (bytes >= (1ull << 20))
+    std::snprintf(text, sizeof(text), "%.1f MiB", double(bytes) / double(1ull << 20));
+  else
+    std::snprintf(text, sizeof(text), "%llu bytes", static_cast<unsigned long long>(bytes));
+  return text;
 }
+
+// The arrays pack_scene packs, in its order (SceneDesc's); the environment's three come last and
+// only with a map.
+constexpr std::array<const char*, 18> kArrayNames = {"BVH node",
+                                                     "BVH triangle",
+                                                     "triangle vertex",
+                                                     "position",
+                                                     "normal",
+                                                     "tangent",
+                                                     "uv",
+                                                     "colour",
+                                                     "material",
+                                                     "texture",
+                                                     "image",
+                                                     "texel",
+                                                     "light",
+                                                     "light alias",
+                                                     "triangle light",
+                                                     "environment texel",
+                                                     "environment marginal",
+                                                     "environment conditional"};
 
 dev::Material device_material(const Material& m) {
   dev::Material d{};
@@ -124,7 +148,8 @@ dev::Camera device_camera(const Camera& c, int width, int height) {
   return d;
 }
 
-PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x) {
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
+                       std::uint64_t max_buffer) {
   const std::size_t tris = scene.triangle_count();
   const std::size_t verts = scene.positions.size();
   std::vector<dev::uint4> tri_vertices(tris);
@@ -152,37 +177,97 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
 
   PackedScene p;
   dev::SceneDesc& d = p.desc;
+  // The arrays in kArrayNames' order, each with the SceneDesc field of its location. The BVH is in
+  // the layout the program was built for (WP_BVH_WIDTH): the same two fields either way.
+  struct Array {
+    const void* data;
+    std::uint64_t bytes;
+    dev::uint* location;
+  };
+  const auto array = [](const auto& items, dev::uint& location) {
+    return Array{items.data(), items.size() * sizeof(items[0]), &location};
+  };
+  std::vector<Array> arrays = {
+      bvh.width == 8 ? array(bvh.nodes8, d.bvh_nodes) : array(bvh.nodes, d.bvh_nodes),
+      bvh.width == 8 ? array(bvh.blocks, d.isect_tris) : array(bvh.triangles, d.isect_tris),
+      array(tri_vertices, d.tri_vertices),
+      array(positions, d.positions),
+      array(normals, d.normals),
+      array(tangents, d.tangents),
+      array(uvs, d.uvs),
+      array(colors, d.colors),
+      array(materials, d.materials),
+      array(textures, d.textures),
+      array(images, d.images),
+      array(texels, d.texels),
+      array(x.lights->lights, d.lights),
+      array(x.lights->alias, d.light_alias),
+      array(x.lights->tri_light, d.tri_light)};
+  if (x.env) {
+    arrays.push_back(array(x.env->texels, d.env_texels));
+    arrays.push_back(array(x.env->marginal, d.env_marginal));
+    arrays.push_back(array(x.env->conditional, d.env_conditional));
+  }
+  if (texels.size() > 0xffffffffu) throw Error(too_many_texels());
+  std::vector<std::uint64_t> sizes;
+  for (const Array& a : arrays) sizes.push_back(a.bytes);
+  const SceneLayout layout = plan_scene_layout(sizes, max_buffer);
+  p.buffers.resize(layout.buffer_bytes.size());
+  for (std::size_t i = 0; i < p.buffers.size(); ++i) p.buffers[i].resize(layout.buffer_bytes[i]);
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    const SceneLayout::Place place = layout.places[i];
+    if (arrays[i].bytes)
+      std::memcpy(p.buffers[place.buffer].data() + place.offset, arrays[i].data, arrays[i].bytes);
+    *arrays[i].location = place.location();
+  }
+
   d.camera = x.camera;
   d.background = f4(x.background);
   const float rotation = x.env_rotation_degrees * 3.14159265358979f / 180.0f;
   d.env_params = {x.env_intensity, std::cos(rotation), std::sin(rotation), 0.0f};
-  // The layout the program was built for (WP_BVH_WIDTH): the same two offsets either way.
-  d.bvh_nodes = bvh.width == 8 ? append(p.bytes, bvh.nodes8) : append(p.bytes, bvh.nodes);
-  d.isect_tris = bvh.width == 8 ? append(p.bytes, bvh.blocks) : append(p.bytes, bvh.triangles);
-  d.tri_vertices = append(p.bytes, tri_vertices);
-  d.positions = append(p.bytes, positions);
-  d.normals = append(p.bytes, normals);
-  d.tangents = append(p.bytes, tangents);
-  d.uvs = append(p.bytes, uvs);
-  d.colors = append(p.bytes, colors);
-  d.materials = append(p.bytes, materials);
-  d.textures = append(p.bytes, textures);
-  d.images = append(p.bytes, images);
-  d.texels = append(p.bytes, texels);
-  d.lights = append(p.bytes, x.lights->lights);
-  d.light_alias = append(p.bytes, x.lights->alias);
-  d.tri_light = append(p.bytes, x.lights->tri_light);
   d.light_count = static_cast<dev::uint>(x.lights->lights.size());
   d.env_light = x.lights->env_light;
   d.triangle_count = static_cast<dev::uint>(tris);
   if (x.env) {
-    d.env_texels = append(p.bytes, x.env->texels);
-    d.env_marginal = append(p.bytes, x.env->marginal);
-    d.env_conditional = append(p.bytes, x.env->conditional);
     d.env_width = static_cast<dev::uint>(x.env->width);
     d.env_height = static_cast<dev::uint>(x.env->height);
   }
   return p;
+}
+
+dev::uint SceneLayout::Place::location() const {
+  return static_cast<dev::uint>(offset / WP_SCENE_ALIGN) << WP_SCENE_BUFFER_BITS |
+         static_cast<dev::uint>(buffer);
+}
+
+std::uint64_t SceneLayout::total_bytes() const {
+  std::uint64_t total = 0;
+  for (const std::uint64_t b : buffer_bytes) total += b;
+  return total;
+}
+
+SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint64_t max_buffer) {
+  max_buffer = std::min(max_buffer, kSceneBufferReach);
+  std::uint64_t total = 0;
+  for (const std::uint64_t size : sizes) total += padded(size);
+  SceneLayout layout;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    const std::uint64_t size = padded(sizes[i]);
+    if (size > max_buffer)
+      throw Error("scene too large for the device: its " + std::string(kArrayNames.at(i)) +
+                  " array needs " + human_bytes(size) +
+                  ", more than the device's largest buffer (" + human_bytes(max_buffer) + ")");
+    if (layout.buffer_bytes.empty() || aligned(layout.buffer_bytes.back()) + size > max_buffer)
+      layout.buffer_bytes.push_back(0);
+    if (layout.buffer_bytes.size() > WP_SCENE_BUFFERS)
+      throw Error("scene too large for the device: " + human_bytes(total) + " does not fit in " +
+                  std::to_string(WP_SCENE_BUFFERS) + " buffers of at most " +
+                  human_bytes(max_buffer) + " (the device's largest buffer)");
+    const std::uint64_t offset = aligned(layout.buffer_bytes.back());
+    layout.places.push_back({static_cast<int>(layout.buffer_bytes.size() - 1), offset});
+    layout.buffer_bytes.back() = offset + size;
+  }
+  return layout;
 }
 
 SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env) {
@@ -225,38 +310,30 @@ BvhBytes min_bvh_bytes(std::uint64_t triangles, int width) {
   return {min_nodes(leaves, 2) * sizeof(dev::BvhNode), triangles * sizeof(dev::IsectTri)};
 }
 
-std::uint64_t packed_end(const SceneCounts& c, const BvhBytes& bvh) {
+SceneLayout scene_layout(const SceneCounts& c, const BvhBytes& bvh, std::uint64_t max_buffer) {
+  if (c.texels > 0xffffffffu) throw Error(too_many_texels());
   // pack_scene's arrays in its order.
-  const std::uint64_t sizes[] = {bvh.nodes,
-                                 bvh.primitives,
-                                 c.triangles * sizeof(dev::uint4),  // tri_vertices
-                                 c.vertices * sizeof(dev::float4),  // positions
-                                 c.vertices * sizeof(dev::float4),  // normals
-                                 c.vertices * sizeof(dev::float4),  // tangents
-                                 c.vertices * sizeof(dev::float4),  // uvs
-                                 c.vertices * sizeof(dev::float4),  // colors
-                                 c.materials * sizeof(dev::Material),
-                                 c.textures * sizeof(dev::TextureRef),
-                                 c.images * sizeof(dev::TextureImage),
-                                 c.texels * sizeof(dev::uint),
-                                 c.punctual_lights * sizeof(dev::Light),
-                                 c.punctual_lights * sizeof(dev::LightAlias),
-                                 c.triangles * sizeof(std::uint32_t),  // tri_light
-                                 c.env_texels * sizeof(glm::vec4),
-                                 c.env_marginal * sizeof(float),
-                                 c.env_conditional * sizeof(float)};
-  const bool env = c.env_texels || c.env_marginal || c.env_conditional;
-  const std::size_t arrays = std::size(sizes) - (env ? 0 : 3);
-  std::uint64_t end = 0, last_end = 0;
-  for (std::size_t i = 0; i < arrays; ++i) {
-    last_end = aligned(end) + sizes[i];
-    end = aligned(end) + padded(sizes[i]);
+  std::vector<std::uint64_t> sizes = {bvh.nodes,
+                                      bvh.primitives,
+                                      c.triangles * sizeof(dev::uint4),  // tri_vertices
+                                      c.vertices * sizeof(dev::float4),  // positions
+                                      c.vertices * sizeof(dev::float4),  // normals
+                                      c.vertices * sizeof(dev::float4),  // tangents
+                                      c.vertices * sizeof(dev::float4),  // uvs
+                                      c.vertices * sizeof(dev::float4),  // colors
+                                      c.materials * sizeof(dev::Material),
+                                      c.textures * sizeof(dev::TextureRef),
+                                      c.images * sizeof(dev::TextureImage),
+                                      c.texels * sizeof(dev::uint),
+                                      c.punctual_lights * sizeof(dev::Light),
+                                      c.punctual_lights * sizeof(dev::LightAlias),
+                                      c.triangles * sizeof(std::uint32_t)};  // tri_light
+  if (c.env_texels || c.env_marginal || c.env_conditional) {
+    sizes.push_back(c.env_texels * sizeof(glm::vec4));
+    sizes.push_back(c.env_marginal * sizeof(float));
+    sizes.push_back(c.env_conditional * sizeof(float));
   }
-  return last_end;
-}
-
-void check_packed_size(const SceneCounts& counts, const BvhBytes& bvh) {
-  if (packed_end(counts, bvh) > kMaxEnd) too_large();
+  return plan_scene_layout(sizes, max_buffer);
 }
 
 }  // namespace wp

@@ -1,5 +1,6 @@
-// The scene as the device sees it: every array packed into one byte buffer at 64-byte aligned
-// offsets recorded in a SceneDesc (kernels/shared/types.h), plus the device camera.
+// The scene as the device sees it: its arrays packed into up to WP_SCENE_BUFFERS byte buffers, each
+// no larger than the device's largest allocation, at 64-byte aligned offsets; a SceneDesc
+// (kernels/shared/types.h) records each array's location. Plus the device camera.
 #pragma once
 
 #include <cstdint>
@@ -16,9 +17,12 @@
 namespace wp {
 
 struct PackedScene {
-  std::vector<unsigned char> bytes;  // uploaded as is
+  std::vector<std::vector<unsigned char>> buffers;  // 1 to WP_SCENE_BUFFERS, uploaded as they are
   dev::SceneDesc desc{};
 };
+
+// The most bytes one scene buffer may hold: a location's 29 bits of 64-byte units reach 32 GiB.
+inline constexpr std::uint64_t kSceneBufferReach = std::uint64_t(1) << 35;
 
 // The device camera for an image of width x height. Perspective: image-plane half extents
 // tan(yfov/2) * aspect and tan(yfov/2) with aspect = width / height (glTF's convention: yfov is
@@ -36,9 +40,28 @@ struct SceneExtras {
   const LightTable* lights = nullptr;  // required
 };
 
-// Throws wp::Error("scene too large for 32-bit buffer offsets") when an array would end past 4 GiB
-// (SceneDesc holds 32-bit offsets).
-PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& extras);
+// Packs the scene into buffers of at most `max_buffer` bytes (the device's CL_DEVICE_MAX_MEM_ALLOC
+// _SIZE; capped at kSceneBufferReach). Throws plan_scene_layout's wp::Error when it does not fit.
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& extras,
+                       std::uint64_t max_buffer = kSceneBufferReach);
+
+// Where the arrays go. Each array, in pack_scene's order, starts at the next 64-byte boundary of
+// the last buffer, or at the start of a new buffer when it would end past max_buffer there.
+struct SceneLayout {
+  struct Place {
+    int buffer = 0;
+    std::uint64_t offset = 0;    // bytes, a multiple of 64
+    dev::uint location() const;  // SceneDesc's encoding (kernels/shared/types.h)
+  };
+  std::vector<Place> places;                // per array
+  std::vector<std::uint64_t> buffer_bytes;  // per buffer: where its last array ends (padded)
+  std::uint64_t total_bytes() const;
+};
+// The layout of arrays of `sizes` bytes. Throws wp::Error("scene too large for the device: ...")
+// naming the array when one alone exceeds max_buffer, or the total when more than
+// WP_SCENE_BUFFERS buffers would be needed. Larger sizes never need fewer buffers (each array's
+// buffer and end only move forward), so a layout of lower bounds that fails means the real fails.
+SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint64_t max_buffer);
 
 // The size check of pack_scene, ahead of it: a scene too large to pack fails before its BVH is
 // built (minutes, and an entry in the BVH cache, for tens of millions of triangles).
@@ -62,11 +85,10 @@ BvhBytes bvh_bytes(const bvh::Bvh& bvh);
 // blocks of 4, inner nodes of 2 (or up to 8) children.
 BvhBytes min_bvh_bytes(std::uint64_t triangles, int width);
 
-// Where the last array pack_scene packs would end with these counts and BVH sizes. A lower bound
-// when they are lower bounds: min_bvh_bytes before the build, and always the lights (the light
-// table's emissive triangles and environment light are not counted), so no scene that fits fails.
-std::uint64_t packed_end(const SceneCounts& counts, const BvhBytes& bvh);
-// Throws pack_scene's wp::Error when packed_end(counts, bvh) is past the 32-bit offsets' reach.
-void check_packed_size(const SceneCounts& counts, const BvhBytes& bvh);
+// pack_scene's layout for these counts and BVH sizes. A lower bound when they are lower bounds:
+// min_bvh_bytes before the build, and always the lights (the light table's emissive triangles and
+// environment light are not counted), so no scene that fits is refused. Throws like
+// plan_scene_layout, and when the images hold 2^32 texels or more (uint texel offsets).
+SceneLayout scene_layout(const SceneCounts& counts, const BvhBytes& bvh, std::uint64_t max_buffer);
 
 }  // namespace wp

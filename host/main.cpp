@@ -41,6 +41,7 @@ struct CliOptions {
   std::string tonemap = "aces";
   float exposure = 0.0f;
   bool spatial_splits = false;
+  std::uint64_t scene_buffer_kib = 0;
   bool json = false;
   bool quiet = false;
 };
@@ -49,11 +50,15 @@ int list_devices() {
   const auto devices = wp::enumerate_devices();
   if (devices.empty())
     throw wp::Error("no OpenCL platform found (install pocl-opencl-icd for CPUs)");
-  std::printf("%-5s %-11s %-16s %s\n", "index", "type", "OpenCL C", "platform / device");
+  // Memory in GiB: the device's global memory and its largest single buffer
+  // (CL_DEVICE_MAX_MEM_ALLOC _SIZE), which bounds the packed scene (device_scene.h).
+  const auto gib = [](unsigned long long bytes) { return double(bytes) / double(1ull << 30); };
+  std::printf("%-5s %-11s %-16s %-8s %-10s %s\n", "index", "type", "OpenCL C", "memory",
+              "max buffer", "platform / device");
   for (const auto& d : devices)
-    std::printf("%-5d %-11s %-16s %s / %s\n", d.index, d.type.c_str(),
+    std::printf("%-5d %-11s %-16s %-8.1f %-10.1f %s / %s\n", d.index, d.type.c_str(),
                 d.c_version.substr(d.c_version.find("OpenCL C") == 0 ? 9 : 0).c_str(),
-                d.platform_name.c_str(), d.name.c_str());
+                gib(d.global_memory), gib(d.max_alloc), d.platform_name.c_str(), d.name.c_str());
   const wp::DeviceEntry def = wp::select_device("");
   std::printf("default: %d (%s)\n", def.index, def.name.c_str());
   return 0;
@@ -98,6 +103,9 @@ void check_options(const CLI::App& render, const CliOptions& cli,
   check(settings.spp <= (1 << 20), "--spp must be at most 1048576");
   check(settings.wave_size <= (std::size_t{1} << 24), "--wave-size must be at most 16777216");
   check(settings.local_size <= 1024, "--local-size must be at most 1024");
+  check(render.count("--scene-buffer-kib") == 0 ||
+            (cli.scene_buffer_kib >= 1 && cli.scene_buffer_kib <= (std::uint64_t{1} << 25)),
+        "--scene-buffer-kib must be between 1 and 33554432 (32 GiB)");
 }
 
 class Progress {
@@ -122,6 +130,7 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   check_options(render, cli, settings);
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
+  settings.scene_buffer_bytes = cli.scene_buffer_kib * 1024;
   settings.strategy = cli.strategy == "nee"    ? wp::Strategy::kNee
                       : cli.strategy == "bsdf" ? wp::Strategy::kBsdf
                                                : wp::Strategy::kMis;
@@ -256,6 +265,9 @@ int main(int argc, char** argv) {
                      "BVH layout: 2 (binary) or 8 (wide, float8 box tests) [default: 2 on GPUs, "
                      "8 on CPUs]");
   render->add_option("--local-size", settings.local_size, "Work-group size [default: 64]");
+  render->add_option("--scene-buffer-kib", cli.scene_buffer_kib,
+                     "Most KiB per scene buffer; the scene is split over up to 8 [default: the "
+                     "device's largest allocation, see `wavepath devices`]");
   render->add_flag("--no-bvh-cache", cli.no_bvh_cache,
                    "Build the BVH afresh; by default it is looked up in and stored to "
                    "$WAVEPATH_CACHE_DIR, else $XDG_CACHE_HOME/wavepath, else ~/.cache/wavepath");

@@ -63,14 +63,15 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
   bool cached = false;
-  // A scene too large to pack (device_scene.h) fails now, not after its BVH is built (minutes for
-  // tens of millions of triangles) and cached: first with the least BVH its triangles need, then,
-  // before it is cached, with the BVH built.
+  // A scene too large for the device's buffers (device_scene.h) fails now, not after its BVH is
+  // built (minutes for tens of millions of triangles) and cached: first with the least BVH its
+  // triangles need, then, before it is cached, with the BVH built.
   const SceneCounts counts = scene_counts(scene, settings.environment.get());
-  check_packed_size(counts, min_bvh_bytes(counts.triangles, bvh_options.width));
+  const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
+  scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer);
   const bvh::Bvh bvh = bvh::build_cached(
       bvh_input(scene, flags), bvh_options, options.bvh_cache ? bvh::cache_dir() : std::string(),
-      &cached, [&counts](const bvh::Bvh& built) { check_packed_size(counts, bvh_bytes(built)); });
+      &cached, [&](const bvh::Bvh& built) { scene_layout(counts, bvh_bytes(built), max_buffer); });
 
   Wavefront wavefront(runtime, scene, bvh, settings);
 
@@ -87,6 +88,8 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.setup_seconds = since(start);
   r.wave_size = wavefront.wave_size();
   r.bytes_per_path = wavefront.path_state().bytes_per_path;
+  r.scene_bytes = wavefront.scene_bytes();
+  r.scene_buffers = wavefront.scene_buffer_count();
 
   const auto passes_start = std::chrono::steady_clock::now();
   for (int s = 0; s < settings.spp; ++s) {

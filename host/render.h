@@ -30,7 +30,9 @@ struct RenderReport {
   std::uint64_t rays = 0;  // closest-hit rays traced (camera and bounce rays; not shadow rays)
   std::size_t wave_size = 0;
   std::size_t bytes_per_path = 0;
-  StageTimes stages;  // with RenderSettings::profile
+  std::uint64_t scene_bytes = 0;  // the packed scene on the device
+  int scene_buffers = 0;          // the buffers it is split over (device_scene.h)
+  StageTimes stages;              // with RenderSettings::profile
   double samples_per_second(const RenderSettings& s) const {
     return render_seconds > 0 ? double(s.width) * s.height * s.spp / render_seconds : 0.0;
   }

@@ -16,7 +16,8 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene,
 // One JSON object on one line. Keys: spp, width, height, seconds (the sample passes),
 // samples_per_second (pixel samples), device, triangles, kernel_build_seconds,
 // bvh_build_seconds, bvh_sah_cost, setup_seconds, first_pass_seconds, load_seconds,
-// total_seconds, nonfinite_samples, rays, features, wave_size, bytes_per_path, outputs, and with
+// total_seconds, nonfinite_samples, rays, features, wave_size, bytes_per_path, scene_bytes,
+// scene_buffers, outputs, and with
 // profiling stage_seconds {stage: seconds}.
 std::string report_json(const RenderSettings& settings, const RenderReport& report,
                         double load_seconds, double total_seconds,

@@ -42,6 +42,11 @@ const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
 
 }  // namespace
 
+std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings) {
+  if (settings.scene_buffer_bytes) return settings.scene_buffer_bytes;
+  return device.max_alloc ? device.max_alloc : kSceneBufferReach;
+}
+
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
     : rt_(runtime), settings_(settings) {
@@ -65,12 +70,13 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   extras.env_intensity = settings.env_intensity;
   extras.env_rotation_degrees = settings.env_rotation;
   extras.lights = &lights_;
-  const PackedScene packed = pack_scene(scene, bvh, extras);
-  desc_ = packed.desc;
   const cl::Context& ctx = rt_.context();
   try {
-    scene_buf_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, packed.bytes.size(),
-                            const_cast<unsigned char*>(packed.bytes.data()));
+    const PackedScene packed =
+        pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings));
+    scene_ = upload_scene(ctx, packed);
+    scene_buffer_count_ = static_cast<int>(packed.buffers.size());
+    for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
     path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
     queue_slots_ =
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
@@ -93,11 +99,19 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
 
   const auto build_start = std::chrono::steady_clock::now();
   program_ = rt_.build(program_source(), options_);
-  for (int i = 0; i < kStageCount; ++i) {
-    if (static_cast<Stage>(i) == Stage::kAccumulate)
-      accumulate_.emplace_back(program_, kStageNames[i]);
-    else
-      stage_kernels_.emplace_back(program_, kStageNames[i]);
+  try {
+    for (int i = 0; i < kStageCount; ++i) {
+      cl::Kernel& k = kernels_.emplace_back(program_, kStageNames[i]);
+      cl_uint arg = set_scene_args(k, 0, scene_);
+      k.setArg(arg++, path_buf_);
+      k.setArg(arg++, path_state_.layout);
+      k.setArg(arg++, queue_slots_);
+      k.setArg(arg++, counters_);
+      launch_arg_ = arg++;
+      if (static_cast<Stage>(i) == Stage::kAccumulate) k.setArg(arg++, film_);
+    }
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "setting the kernels' arguments on " + rt_.device().name);
   }
   prime_kernels();
   try {
@@ -130,16 +144,12 @@ cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch&
   if (items == 0) return cl::Event();
   const std::size_t local = local_size_;
   const std::size_t global = local ? (items + local - 1) / local * local : items;
-  const cl::EnqueueArgs args(rt_.queue(), cl::NDRange(global),
-                             local ? cl::NDRange(local) : cl::NullRange);
+  cl::Kernel& kernel = kernels_[static_cast<int>(stage)];
   cl::Event event;
   try {
-    if (stage == Stage::kAccumulate)
-      event = accumulate_.front()(args, scene_buf_, desc_, path_buf_, path_state_.layout,
-                                  queue_slots_, counters_, params, film_);
-    else
-      event = stage_kernels_[static_cast<int>(stage)](
-          args, scene_buf_, desc_, path_buf_, path_state_.layout, queue_slots_, counters_, params);
+    kernel.setArg(launch_arg_, params);
+    rt_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
+                                     local ? cl::NDRange(local) : cl::NullRange, nullptr, &event);
   } catch (const cl::Error& e) {
     rethrow_cl(e, std::string("launching ") + stage_name(stage));
   }

@@ -17,6 +17,7 @@
 #include "host/light_table.h"
 #include "host/path_state.h"
 #include "host/scene.h"
+#include "host/scene_buffers.h"
 #include "host/scene_features.h"
 #include "host/stages.h"
 #include "kernels/shared/types.h"
@@ -49,7 +50,13 @@ struct RenderSettings {
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
   int bvh_width = 0;           // BVH layout: 2, 8, or 0 for the device's default (render.h)
+  // Most bytes in one scene buffer (device_scene.h); 0: the device's largest allocation. Smaller
+  // values split even small scenes over several buffers (tests).
+  std::uint64_t scene_buffer_bytes = 0;
 };
+
+// The most bytes of one scene buffer on `device` with `settings`.
+std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
 
 struct FilmImages {
   std::vector<float> mean;
@@ -80,6 +87,9 @@ class Wavefront {
   // Closest-hit rays (camera and bounce) traced by render_pass so far: a cost measure that, unlike
   // time, does not depend on what else the machine is doing.
   std::uint64_t rays_traced() const { return rays_traced_; }
+  // The packed scene on the device: its bytes and the buffers they are split over.
+  std::uint64_t scene_bytes() const { return scene_bytes_; }
+  int scene_buffer_count() const { return scene_buffer_count_; }
 
   // Stage-level access for tests and benchmarks. Field offsets are those of path_state().layout,
   // e.g. write_paths(path_state().layout.ray_o, rays).
@@ -144,7 +154,6 @@ class Wavefront {
   RenderSettings settings_;
   SceneFeatures features_;
   LightTable lights_;
-  dev::SceneDesc desc_{};
   PathStateLayout path_state_;
   std::size_t wave_size_ = 0;
   std::size_t local_size_ = 0;
@@ -153,17 +162,15 @@ class Wavefront {
   std::uint64_t rays_traced_ = 0;
   std::string options_;
 
-  cl::Buffer scene_buf_, path_buf_, queue_slots_, counters_, film_;
+  SceneBuffers scene_;
+  std::uint64_t scene_bytes_ = 0;
+  int scene_buffer_count_ = 0;
+  cl::Buffer path_buf_, queue_slots_, counters_, film_;
   cl::Program program_;
-  // Typed launches: every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h); accumulate adds
-  // the film.
-  using StageKernel = cl::KernelFunctor<cl::Buffer, dev::SceneDesc, cl::Buffer, dev::PathLayout,
-                                        cl::Buffer, cl::Buffer, dev::Launch>;
-  using AccumulateKernel =
-      cl::KernelFunctor<cl::Buffer, dev::SceneDesc, cl::Buffer, dev::PathLayout, cl::Buffer,
-                        cl::Buffer, dev::Launch, cl::Buffer>;
-  std::vector<StageKernel> stage_kernels_;  // indexed by Stage, all but kAccumulate
-  std::vector<AccumulateKernel> accumulate_;
+  // Every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h), accumulate the film after them.
+  // All but the Launch argument are set once, when the kernels are made.
+  std::vector<cl::Kernel> kernels_;  // indexed by Stage
+  cl_uint launch_arg_ = 0;           // the index of the Launch argument
   std::vector<std::pair<Stage, cl::Event>> pending_events_;
   StageTimes times_;
 };

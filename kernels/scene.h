@@ -1,4 +1,4 @@
-/* The scene as kernels see it: typed pointers into the one scene buffer (offsets in SceneDesc). */
+/* The scene as kernels see it: typed pointers into the scene buffers (locations in SceneDesc). */
 #ifndef WP_SCENE_H
 #define WP_SCENE_H
 
@@ -26,26 +26,45 @@ typedef struct SceneView {
   const SceneDesc* desc; /* counts, camera, background, environment parameters */
 } SceneView;
 
-inline SceneView scene_bind(__global const uchar* base, const SceneDesc* d) {
+/* The scene's kernel arguments: its buffers (unused ones repeat the first) and its SceneDesc. */
+#define WP_SCENE_PARAMS                                                                         \
+  __global const uchar *scene0, __global const uchar *scene1, __global const uchar *scene2,     \
+      __global const uchar *scene3, __global const uchar *scene4, __global const uchar *scene5, \
+      __global const uchar *scene6, __global const uchar *scene7, SceneDesc scene_desc
+
+/* Declares `view`, the SceneView of WP_SCENE_PARAMS. */
+#define WP_SCENE_BIND(view)                                                                  \
+  __global const uchar* view##_buffers[WP_SCENE_BUFFERS] = {scene0, scene1, scene2, scene3,  \
+                                                            scene4, scene5, scene6, scene7}; \
+  const SceneView view = scene_bind(view##_buffers, &scene_desc)
+
+/* The first byte of the array at `location` (kernels/shared/types.h). */
+inline __global const uchar* scene_array(__global const uchar* const* buffers, uint location) {
+  return buffers[location & (WP_SCENE_BUFFERS - 1)] +
+         (ulong)(location & ~(uint)(WP_SCENE_BUFFERS - 1)) *
+             (WP_SCENE_ALIGN >> WP_SCENE_BUFFER_BITS);
+}
+
+inline SceneView scene_bind(__global const uchar* const* b, const SceneDesc* d) {
   SceneView s;
-  s.nodes = (__global const BvhNode*)(base + d->bvh_nodes);
-  s.tris = (__global const IsectTri*)(base + d->isect_tris);
-  s.tri_vertices = (__global const uint4*)(base + d->tri_vertices);
-  s.positions = (__global const float4*)(base + d->positions);
-  s.normals = (__global const float4*)(base + d->normals);
-  s.tangents = (__global const float4*)(base + d->tangents);
-  s.uvs = (__global const float4*)(base + d->uvs);
-  s.colors = (__global const float4*)(base + d->colors);
-  s.materials = (__global const Material*)(base + d->materials);
-  s.textures = (__global const TextureRef*)(base + d->textures);
-  s.images = (__global const TextureImage*)(base + d->images);
-  s.texels = (__global const uint*)(base + d->texels);
-  s.lights = (__global const Light*)(base + d->lights);
-  s.light_alias = (__global const LightAlias*)(base + d->light_alias);
-  s.tri_light = (__global const uint*)(base + d->tri_light);
-  s.env_texels = (__global const float4*)(base + d->env_texels);
-  s.env_marginal = (__global const float*)(base + d->env_marginal);
-  s.env_conditional = (__global const float*)(base + d->env_conditional);
+  s.nodes = (__global const BvhNode*)scene_array(b, d->bvh_nodes);
+  s.tris = (__global const IsectTri*)scene_array(b, d->isect_tris);
+  s.tri_vertices = (__global const uint4*)scene_array(b, d->tri_vertices);
+  s.positions = (__global const float4*)scene_array(b, d->positions);
+  s.normals = (__global const float4*)scene_array(b, d->normals);
+  s.tangents = (__global const float4*)scene_array(b, d->tangents);
+  s.uvs = (__global const float4*)scene_array(b, d->uvs);
+  s.colors = (__global const float4*)scene_array(b, d->colors);
+  s.materials = (__global const Material*)scene_array(b, d->materials);
+  s.textures = (__global const TextureRef*)scene_array(b, d->textures);
+  s.images = (__global const TextureImage*)scene_array(b, d->images);
+  s.texels = (__global const uint*)scene_array(b, d->texels);
+  s.lights = (__global const Light*)scene_array(b, d->lights);
+  s.light_alias = (__global const LightAlias*)scene_array(b, d->light_alias);
+  s.tri_light = (__global const uint*)scene_array(b, d->tri_light);
+  s.env_texels = (__global const float4*)scene_array(b, d->env_texels);
+  s.env_marginal = (__global const float*)scene_array(b, d->env_marginal);
+  s.env_conditional = (__global const float*)scene_array(b, d->env_conditional);
   s.desc = d;
   return s;
 }

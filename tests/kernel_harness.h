@@ -10,6 +10,7 @@
 
 #include "host/cl_runtime.h"
 #include "host/kernel_sources.h"
+#include "host/scene_buffers.h"
 
 namespace wp {
 // The test target's tests/kernels tree, embedded like the core kernels (tests/CMakeLists.txt).
@@ -40,7 +41,8 @@ class KernelHarness {
   }
   template <class T>
   cl::Buffer buffer(std::size_t count) {
-    return cl::Buffer(runtime_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(1, count) * sizeof(T));
+    return cl::Buffer(runtime_.context(), CL_MEM_READ_WRITE,
+                      std::max<std::size_t>(1, count) * sizeof(T));
   }
   template <class T>
   std::vector<T> read(const cl::Buffer& b, std::size_t count) {
@@ -49,17 +51,28 @@ class KernelHarness {
     return out;
   }
 
-  // Runs kernel `name` over `items` work-items with the given arguments and waits.
+  // Runs kernel `name` over `items` work-items with the given arguments and waits. A SceneBuffers
+  // argument stands for the WP_SCENE_PARAMS it sets (host/scene_buffers.h).
   template <class... Args>
-  void run(const char* name, std::size_t items, Args&&... args) {
-    cl::KernelFunctor<std::decay_t<Args>...> k(program_, name);
+  void run(const char* name, std::size_t items, const Args&... args) {
+    cl::Kernel k(program_, name);
+    cl_uint index = 0;
+    (set_arg(k, index, args), ...);
     const std::size_t local = 64, global = (items + local - 1) / local * local;
-    k(cl::EnqueueArgs(runtime_.queue(), cl::NDRange(global), cl::NDRange(local)),
-      std::forward<Args>(args)...);
+    runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global),
+                                          cl::NDRange(local));
     runtime_.queue().finish();
   }
 
  private:
+  template <class T>
+  static void set_arg(cl::Kernel& k, cl_uint& index, const T& arg) {
+    k.setArg(index++, arg);
+  }
+  static void set_arg(cl::Kernel& k, cl_uint& index, const SceneBuffers& scene) {
+    index = set_scene_args(k, index, scene);
+  }
+
   ClRuntime runtime_;
   cl::Program program_;
 };

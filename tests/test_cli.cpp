@@ -138,10 +138,18 @@ TEST_F(Cli, ParseErrorsExitWithStatusOne) {
 TEST_F(Cli, OutOfRangeOptionValues) {
   const std::string scene = "render '" + cornell() + "' ";
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"--camera -1", "--camera -1"},        {"--camera 1", "--camera 1: the scene has 1 camera"},
-      {"--exposure nan", "--exposure"},      {"--exposure inf", "--exposure"},
-      {"--exposure 1e6", "--exposure"},      {"--spp 2000000", "--spp"},
-      {"--local-size 4096", "--local-size"}, {"--wave-size 100000000", "--wave-size"}};
+      {"--camera -1", "--camera -1"},
+      {"--camera 1", "--camera 1: the scene has 1 camera"},
+      {"--exposure nan", "--exposure"},
+      {"--exposure inf", "--exposure"},
+      {"--exposure 1e6", "--exposure"},
+      {"--spp 2000000", "--spp"},
+      {"--local-size 4096", "--local-size"},
+      {"--wave-size 100000000", "--wave-size"},
+      {"--scene-buffer-kib 0", "--scene-buffer-kib"},
+      {"--scene-buffer-kib 40000000", "--scene-buffer-kib"},
+      // Not wrong, but the Cornell box's BVH does not fit in one KiB: the device's limit, named.
+      {"--scene-buffer-kib 1", "scene too large for the device: its BVH triangle array needs"}};
   for (const auto& [args, cause] : cases) {
     const CliRun r = run(scene + args + " --width 8 --height 8 --spp 1");
     EXPECT_EQ(r.status, 1) << args;

@@ -4,10 +4,10 @@
 # on), --data-races, --uninitialized and --check-api. A case fails when wavepath exits non-zero or
 # when Oclgrind reports anything at all: every message it logs is a diagnostic (invalid read or
 # write, data race, uninitialised value, OpenCL API error, fatal error, ...). The cases cover both
-# BVH layouts, `--features all`, several waves and work-groups, an environment map, transmission,
-# punctual lights, degenerate triangles and, from the shared assets, textures, alpha (MASK and
-# BLEND) and transmission models; an asset case is skipped (with a message) when its file is
-# absent. A canary renders with one kernel made to read past the counter buffer and must be
+# BVH layouts, `--features all`, several waves and work-groups, scenes split over several device
+# buffers, an environment map, transmission, punctual lights, degenerate triangles and, from the
+# shared assets, textures, alpha (MASK and BLEND) and transmission models; an asset case is
+# skipped (with a message) when its file is absent. A canary renders with one kernel made to read past the counter buffer and must be
 # reported, so that the test cannot pass because Oclgrind checked nothing.
 #
 # Usage: test_oclgrind.sh WAVEPATH SOURCE_DIR [ASSETS_DIR]
@@ -132,12 +132,14 @@ models=$assets/models
 
 # In the repository: both BVH layouts, all features, several waves of several work-groups (and a
 # partial last group), an environment map, glass and mirrors, punctual lights, degenerate
-# triangles.
+# triangles, and scenes split over several scene buffers (3 each, --json's scene_buffers).
 check cornell_bvh2 "$scenes/cornell_box.gltf" --bvh-width 2
 check cornell_bvh8_all "$scenes/cornell_box.gltf" --bvh-width 8 --features all --local-size 16
 check point_waves "$scenes/cornell_box_point.gltf" --bvh-width 8 --spp 2 --wave-size 20 \
   --local-size 16
-check env_sun "$scenes/failure/env_sun.gltf" --env "$scenes/failure/env_sun.hdr" --bvh-width 2
+check cornell_split "$scenes/cornell_box.gltf" --bvh-width 8 --scene-buffer-kib 4
+check env_sun_split "$scenes/failure/env_sun.gltf" --env "$scenes/failure/env_sun.hdr" \
+  --bvh-width 2 --scene-buffer-kib 2048
 check caustics "$scenes/failure/caustics.gltf" --bvh-width 8
 check punctual "$scenes/failure/punctual.gltf" --bvh-width 8 --features all
 check degenerate "$scenes/failure/degenerate.gltf" --bvh-width 2 --local-size 16

@@ -1,8 +1,9 @@
-// The size check of the packed scene (host/device_scene.h), run before the BVH build: its
-// arithmetic agrees with pack_scene's, its BVH estimate never exceeds a real BVH (so no scene that
-// fits is refused), counts past 4 GiB are refused, and render() refuses them before it builds or
-// caches a BVH. Counts stand in for scenes of tens of millions of triangles: nothing large is
-// allocated.
+// The scene's split into device buffers (host/device_scene.h), checked before the BVH build: the
+// layout from counts agrees with pack_scene's, its BVH estimate never exceeds a real BVH (so no
+// scene that fits is refused), arrays never cross or exceed a buffer, scenes past the device's
+// buffers are refused before render() builds or caches a BVH, and a scene split over several
+// buffers renders exactly as in one. Counts stand in for scenes of tens of millions of
+// triangles: nothing large is allocated.
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -22,8 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace wp;
 
-constexpr const char* kTooLarge = "scene too large for 32-bit buffer offsets";
-constexpr std::uint64_t kMaxEnd = 0xffffffffu;
+constexpr std::uint64_t kGiB = std::uint64_t(1) << 30;
+constexpr const char* kTooLarge = "scene too large for the device";
 
 // A soup of `triangles` random triangles, one (non-emissive) material, a punctual light and a
 // 3 x 2 texture.
@@ -57,6 +58,7 @@ bvh::Bvh build_bvh(const Scene& s, int width, bool splits = false, int max_leaf 
   return bvh::build(bvh_input(s, flags), o);
 }
 
+// The error f throws, or "" when it returns.
 std::string error_of(const std::function<void()>& f) {
   try {
     f();
@@ -66,15 +68,27 @@ std::string error_of(const std::function<void()>& f) {
   return "";
 }
 
-// With the BVH's real sizes and the light table's real light count, packed_end is exactly where
-// pack_scene's last array ends, with and without an environment map (whose three arrays come last).
-TEST(PackedSize, EndAgreesWithPackScene) {
-  const Scene s = small_scene(300);
+bool refused(const std::function<void()>& f) {
+  return error_of(f).rfind(kTooLarge, 0) == 0;
+}
+
+std::unique_ptr<EnvironmentMap> small_map() {
   auto env = std::make_unique<EnvironmentMap>();
   env->width = 8;
   env->height = 4;
-  env->texels.assign(8 * 4, glm::vec4(0.5f, 0.5f, 0.5f, 0.0f));
+  env->texels.resize(8 * 4);
+  for (std::size_t i = 0; i < env->texels.size(); ++i)
+    env->texels[i] = glm::vec4(0.2f + 0.1f * float(i % 5), 0.5f, 0.3f + 0.05f * float(i % 3), 0);
   build_environment_tables(*env);
+  return env;
+}
+
+// With the BVH's real sizes and the light table's real light count, scene_layout places every
+// array where pack_scene does and sizes every buffer alike: with and without an environment map
+// (whose three arrays come last), in one buffer and split over several.
+TEST(PackedSize, LayoutAgreesWithPackScene) {
+  const Scene s = small_scene(300);
+  const auto env = small_map();
   const std::vector<const EnvironmentMap*> maps = {nullptr, env.get()};
   for (int width : {2, 8}) {
     const bvh::Bvh b = build_bvh(s, width);
@@ -84,21 +98,82 @@ TEST(PackedSize, EndAgreesWithPackScene) {
       SceneExtras x;
       x.env = map;
       x.lights = &lights;
-      const PackedScene packed = pack_scene(s, b, x);
       SceneCounts c = scene_counts(s, map);
       EXPECT_EQ(c.triangles, 300u);
       EXPECT_EQ(c.texels, 6u);
       EXPECT_EQ(c.env_texels, map ? 32u : 0u);
-      // Only the punctual light is counted up front: a lower bound.
-      EXPECT_LE(packed_end(c, bvh_bytes(b)), packed.bytes.size());
-      c.punctual_lights = lights.lights.size();
-      // The last array (tri_light, or the environment's conditional table) is over 16 bytes, so
-      // it ends where the bytes do.
-      EXPECT_EQ(packed_end(c, bvh_bytes(b)), packed.bytes.size())
-          << "width " << width << (map ? " with" : " without") << " a map";
-      EXPECT_EQ(packed.desc.triangle_count, 300u);
+      const std::uint64_t one = scene_layout(c, bvh_bytes(b), kSceneBufferReach).total_bytes();
+      for (std::uint64_t max_buffer : {kSceneBufferReach, one / 2, one / 3}) {
+        const PackedScene packed = pack_scene(s, b, x, max_buffer);
+        // Only the punctual light is counted up front: a lower bound.
+        c.punctual_lights = s.lights.size();
+        EXPECT_LE(scene_layout(c, bvh_bytes(b), max_buffer).total_bytes(), one);
+        c.punctual_lights = lights.lights.size();
+        const SceneLayout layout = scene_layout(c, bvh_bytes(b), max_buffer);
+        ASSERT_EQ(layout.buffer_bytes.size(), packed.buffers.size());
+        for (std::size_t i = 0; i < packed.buffers.size(); ++i) {
+          EXPECT_EQ(layout.buffer_bytes[i], packed.buffers[i].size());
+          EXPECT_LE(packed.buffers[i].size(), max_buffer);
+        }
+        if (max_buffer < one) {
+          EXPECT_GE(packed.buffers.size(), 3u);
+        }
+        const dev::uint locations[] = {packed.desc.bvh_nodes,    packed.desc.isect_tris,
+                                       packed.desc.tri_vertices, packed.desc.positions,
+                                       packed.desc.tri_light,    packed.desc.env_conditional};
+        const std::size_t indices[] = {0, 1, 2, 3, 14, 17};
+        for (std::size_t k = 0; k < std::size(indices); ++k)
+          if (indices[k] < layout.places.size()) {
+            EXPECT_EQ(locations[k], layout.places[indices[k]].location()) << "array " << k;
+          }
+        EXPECT_EQ(packed.desc.triangle_count, 300u);
+      }
     }
   }
+}
+
+// Each array starts on a 64-byte boundary, never crosses the end of a buffer, and starts a new
+// buffer only when it would cross; locations encode buffer and offset; refusals name the cause.
+TEST(PackedSize, ArraysAreSplitOverBuffersWithoutCrossingOne) {
+  const std::vector<std::uint64_t> sizes = {1000, 0, 5, 3000, 64, 4096, 1, 2500, 777, 0};
+  for (std::uint64_t max_buffer : {4096u, 5000u, 8192u, 100000u}) {
+    const SceneLayout layout = plan_scene_layout(sizes, max_buffer);
+    ASSERT_EQ(layout.places.size(), sizes.size());
+    std::uint64_t end = 0;
+    int buffer = 0;
+    for (std::size_t i = 0; i < sizes.size(); ++i) {
+      const SceneLayout::Place p = layout.places[i];
+      const std::uint64_t size = std::max<std::uint64_t>(sizes[i], 16);
+      const std::uint64_t next = (end + 63) / 64 * 64;
+      if (i > 0 && next + size <= max_buffer) {  // fits after the previous array
+        EXPECT_EQ(p.buffer, buffer) << i;
+        EXPECT_EQ(p.offset, next) << i;
+      } else {
+        EXPECT_EQ(p.buffer, i > 0 ? buffer + 1 : 0) << i;
+        EXPECT_EQ(p.offset, 0u) << i;
+      }
+      buffer = p.buffer;
+      end = p.offset + size;
+      EXPECT_LE(end, max_buffer);
+      EXPECT_EQ(p.location(), dev::uint(p.offset / 64) << 3 | dev::uint(p.buffer));
+      EXPECT_EQ(layout.buffer_bytes[p.buffer], std::max(layout.buffer_bytes[p.buffer], end));
+    }
+    EXPECT_EQ(layout.buffer_bytes.size(), std::size_t(buffer) + 1);
+  }
+  EXPECT_EQ(error_of([&] { plan_scene_layout(sizes, 4095); }),
+            "scene too large for the device: its tangent array needs 4096 bytes, more than the "
+            "device's largest buffer (4095 bytes)");
+  // Eight buffers at most: nine arrays that each fill one are refused.
+  const std::vector<std::uint64_t> nine(9, kGiB);
+  EXPECT_EQ(plan_scene_layout({nine.begin(), nine.end() - 1}, kGiB).buffer_bytes.size(), 8u);
+  EXPECT_EQ(error_of([&] { plan_scene_layout(nine, kGiB); }),
+            "scene too large for the device: 9.00 GiB does not fit in 8 buffers of at most "
+            "1.00 GiB (the device's largest buffer)");
+  // A location reaches 32 GiB into a buffer: larger limits are capped there.
+  const SceneLayout far = plan_scene_layout({20 * kGiB, 12 * kGiB, 1}, 64 * kGiB);
+  EXPECT_EQ(far.places[1].offset, 20 * kGiB);
+  EXPECT_EQ(far.places[2].buffer, 1);
+  EXPECT_EQ(far.places[1].location(), dev::uint(20 * kGiB / 64) << 3);
 }
 
 // The BVH estimate used before the build is at most what any build makes: both layouts, with and
@@ -126,46 +201,44 @@ TEST(PackedSize, MinBvhBytesBoundsEveryBuild) {
   EXPECT_EQ(min_bvh_bytes(8000000, 8).nodes, 71429u * 224u);  // ceil((500000 - 1) / 7) nodes
 }
 
-// A scene of 20 million unshared triangles (60 million vertices, 80 bytes each on the device)
-// cannot fit, whatever its BVH: refused from its counts alone. A million fit.
-TEST(PackedSize, CountsPastFourGibAreRefused) {
+// A scene of 20 million unshared triangles (60 million vertices, 80 bytes each on the device,
+// about 5.8 GiB in all) fits in PoCL's buffers of 2 GiB, split over several, in either BVH layout;
+// 60 million do not, refused from their counts alone.
+TEST(PackedSize, ScenesLargerThanOneBufferAreSplit) {
   SceneCounts big;
   big.triangles = 20000000;
   big.vertices = 60000000;
   big.materials = 1;
   for (int width : {2, 8}) {
-    EXPECT_GT(packed_end(big, min_bvh_bytes(big.triangles, width)), kMaxEnd);
-    EXPECT_EQ(error_of([&] { check_packed_size(big, min_bvh_bytes(big.triangles, width)); }),
-              kTooLarge);
-    SceneCounts small = big;
-    small.triangles = 1000000;
-    small.vertices = 3000000;
-    EXPECT_EQ(error_of([&] { check_packed_size(small, min_bvh_bytes(small.triangles, width)); }),
-              "");
+    const SceneLayout layout = scene_layout(big, min_bvh_bytes(big.triangles, width), 2 * kGiB);
+    EXPECT_GE(layout.buffer_bytes.size(), 4u);
+    EXPECT_GT(layout.total_bytes(), 5 * kGiB);
+    SceneCounts huge = big;
+    huge.triangles *= 3;
+    huge.vertices *= 3;
+    EXPECT_TRUE(
+        refused([&] { scene_layout(huge, min_bvh_bytes(huge.triangles, width), 2 * kGiB); }));
+    EXPECT_NO_THROW(scene_layout(huge, min_bvh_bytes(huge.triangles, width), 8 * kGiB));
   }
-  // Textures count too: one 32768 x 32768 image is 4 GiB of texels.
+  // Textures count too: one 32768 x 32768 image is 4 GiB of texels, more than one 2 GiB buffer,
+  // and fits in 4 GiB ones; 65536 x 65536 is 2^32 texels, past the uint texel offsets.
   SceneCounts textured;
   textured.triangles = 2;
   textured.vertices = 4;
   textured.images = 1;
   textured.texels = std::uint64_t(32768) * 32768;
-  EXPECT_EQ(error_of([&] { check_packed_size(textured, min_bvh_bytes(2, 8)); }), kTooLarge);
-  // The limit is the last byte a 32-bit offset reaches: find the most texels that fit.
-  std::uint64_t lo = 0, hi = textured.texels;  // fits, does not
-  while (hi - lo > 1) {
-    textured.texels = lo + (hi - lo) / 2;
-    (packed_end(textured, min_bvh_bytes(2, 8)) <= kMaxEnd ? lo : hi) = textured.texels;
-  }
-  textured.texels = lo;
-  EXPECT_EQ(error_of([&] { check_packed_size(textured, min_bvh_bytes(2, 8)); }), "");
-  EXPECT_GT(packed_end(textured, min_bvh_bytes(2, 8)), kMaxEnd - 64);
-  textured.texels = hi;
-  EXPECT_EQ(error_of([&] { check_packed_size(textured, min_bvh_bytes(2, 8)); }), kTooLarge);
+  EXPECT_EQ(error_of([&] { scene_layout(textured, min_bvh_bytes(2, 8), 2 * kGiB); }),
+            "scene too large for the device: its texel array needs 4.00 GiB, more than the "
+            "device's largest buffer (2.00 GiB)");
+  EXPECT_NO_THROW(scene_layout(textured, min_bvh_bytes(2, 8), 4 * kGiB));
+  textured.texels = std::uint64_t(65536) * 65536;
+  EXPECT_EQ(error_of([&] { scene_layout(textured, min_bvh_bytes(2, 8), kSceneBufferReach); }),
+            "scene too large for the device: more than 2^32 texels in its images");
 }
 
-// render() refuses a scene too large to pack before it builds its BVH: nothing reaches the BVH
-// cache. The scene is small but for an image that claims 65536 x 65536 texels (16 GiB; its pixels
-// are never read, as the check comes first).
+// render() refuses a scene too large for the device before it builds its BVH: nothing reaches the
+// BVH cache. The scene is small but for an image that claims 65536 x 65536 texels (16 GiB; its
+// pixels are never read, as the check comes first).
 TEST(PackedSize, RenderRefusesBeforeBuildingTheBvh) {
   const fs::path dir = fs::temp_directory_path() / ("wp_packed_size_" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -181,10 +254,41 @@ TEST(PackedSize, RenderRefusesBeforeBuildingTheBvh) {
   settings.spp = 1;
   RenderOptions options;
   options.bvh_cache = true;
-  EXPECT_EQ(error_of([&] { render(runtime, s, settings, options); }), kTooLarge);
+  EXPECT_TRUE(refused([&] { render(runtime, s, settings, options); }));
   EXPECT_TRUE(!fs::exists(dir) || fs::is_empty(dir)) << "a BVH was built and cached";
   fs::remove_all(dir);
   unsetenv("WAVEPATH_CACHE_DIR");
+}
+
+// The kernels find every array wherever it lies: a textured, lit scene with an environment map,
+// split over several buffers, renders bit for bit as in one, with either BVH layout.
+TEST(PackedSize, SplitSceneRendersExactlyAsOne) {
+  const Scene s = small_scene(200);
+  ClRuntime runtime(select_device(""));
+  RenderSettings settings;
+  settings.width = 24;
+  settings.height = 16;
+  settings.spp = 2;
+  settings.environment = small_map();
+  for (int width : {2, 8}) {
+    settings.bvh_width = width;
+    settings.scene_buffer_bytes = 0;
+    const Rendered one = render(runtime, s, settings);
+    // A buffer a fifth of the scene: several buffers, checked through the same layout.
+    std::vector<std::uint32_t> flags;
+    bvh::BuildOptions o;
+    o.width = width;
+    const bvh::Bvh b = bvh::build(bvh_input(s, flags), o);
+    const SceneCounts c = scene_counts(s, settings.environment.get());
+    const std::uint64_t total = scene_layout(c, bvh_bytes(b), kSceneBufferReach).total_bytes();
+    settings.scene_buffer_bytes = total / 5;
+    ASSERT_GE(scene_layout(c, bvh_bytes(b), total / 5).buffer_bytes.size(), 4u);
+    const Rendered split = render(runtime, s, settings);
+    EXPECT_EQ(one.image.rgb, split.image.rgb) << "BVH width " << width;
+    double sum = 0.0;
+    for (float v : one.image.rgb) sum += v;
+    EXPECT_GT(sum, 0.0);  // not trivially equal
+  }
 }
 
 }  // namespace

@@ -36,18 +36,11 @@ wp::test::KernelHarness& harness() {
   return h;
 }
 
-// A packed scene on the device.
-struct DeviceScene {
-  cl::Buffer buffer;
-  wp::dev::SceneDesc desc{};
-};
-
-DeviceScene upload(const wp::Scene& s, wp::test::KernelHarness& h = harness()) {
+wp::SceneBuffers upload(const wp::Scene& s, wp::test::KernelHarness& h = harness()) {
   const wp::LightTable lights;
   wp::SceneExtras extras;
   extras.lights = &lights;
-  const wp::PackedScene p = wp::pack_scene(s, wp::bvh::Bvh{}, extras);
-  return {h.buffer(p.bytes), p.desc};
+  return wp::upload_scene(h.runtime().context(), wp::pack_scene(s, wp::bvh::Bvh{}, extras));
 }
 
 float4 f4(glm::vec4 v) {
@@ -177,11 +170,11 @@ bool near_border(const glm::dvec2& p, const glm::dvec2& bound) {
   return std::abs(p.x - std::round(p.x)) <= bound.x || std::abs(p.y - std::round(p.y)) <= bound.y;
 }
 
-std::vector<float4> sample(const DeviceScene& d, const std::vector<int>& refs,
+std::vector<float4> sample(const wp::SceneBuffers& d, const std::vector<int>& refs,
                            const std::vector<float4>& uvs) {
   auto& h = harness();
   const cl::Buffer r = h.buffer(refs), u = h.buffer(uvs), out = h.buffer<float4>(uvs.size());
-  h.run("sample_textures", uvs.size(), d.buffer, d.desc, r, u, cl_uint(uvs.size()), out);
+  h.run("sample_textures", uvs.size(), d, r, u, cl_uint(uvs.size()), out);
   return h.read<float4>(out, uvs.size());
 }
 
@@ -295,10 +288,11 @@ struct AlphaResult {
   bool passes;
 };
 
-std::vector<AlphaResult> alpha_queries(const DeviceScene& d, const std::vector<uint4>& queries) {
+std::vector<AlphaResult> alpha_queries(const wp::SceneBuffers& d,
+                                       const std::vector<uint4>& queries) {
   auto& h = harness();
   const cl::Buffer q = h.buffer(queries), out = h.buffer<float4>(queries.size());
-  h.run("alpha_queries", queries.size(), d.buffer, d.desc, q, cl_uint(queries.size()), out);
+  h.run("alpha_queries", queries.size(), d, q, cl_uint(queries.size()), out);
   std::vector<AlphaResult> r;
   for (const float4& f : h.read<float4>(out, queries.size())) r.push_back({f.x, f.y != 0.0f});
   return r;
@@ -365,13 +359,12 @@ TEST(Alpha, BlendFrequency) {
   }
   s.materials.push_back(alpha_material(wp::AlphaMode::kBlend, 0.5f));
   add_square(s, 6);
-  const DeviceScene d = upload(s);
+  const wp::SceneBuffers d = upload(s);
   auto& h = harness();
   constexpr std::uint32_t kN = 1u << 20;
   for (std::uint32_t m = 0; m < 6; ++m) {
     const cl::Buffer counts = h.buffer(std::vector<cl_uint>{0, 0});
-    h.run("alpha_frequency", kN, d.buffer, d.desc, cl_uint(2 * m), cl_uint(12), cl_uint(kN),
-          counts);
+    h.run("alpha_frequency", kN, d, cl_uint(2 * m), cl_uint(12), cl_uint(kN), counts);
     const std::vector<cl_uint> c = h.read<cl_uint>(counts, 2);
     const double a = alphas[m], n = kN;
     EXPECT_NEAR(c[0], n * a, 5.0 * std::sqrt(n * a * (1.0 - a))) << "alpha " << a;
@@ -397,7 +390,7 @@ struct SurfaceQuery {
   glm::vec3 d;
 };
 
-std::vector<Resolved> resolve(const DeviceScene& d, const std::vector<SurfaceQuery>& queries,
+std::vector<Resolved> resolve(const wp::SceneBuffers& d, const std::vector<SurfaceQuery>& queries,
                               wp::test::KernelHarness& h = harness()) {
   std::vector<float4> q, rays;
   for (const SurfaceQuery& x : queries) {
@@ -407,7 +400,7 @@ std::vector<Resolved> resolve(const DeviceScene& d, const std::vector<SurfaceQue
     rays.push_back(f4(glm::vec4(glm::normalize(x.d), 0.0f)));
   }
   const cl::Buffer qb = h.buffer(q), rb = h.buffer(rays), out = h.buffer<float4>(4 * q.size());
-  h.run("resolve_surfaces", q.size(), d.buffer, d.desc, qb, rb, cl_uint(q.size()), out);
+  h.run("resolve_surfaces", q.size(), d, qb, rb, cl_uint(q.size()), out);
   const std::vector<float4> o = h.read<float4>(out, 4 * q.size());
   std::vector<Resolved> r;
   for (std::size_t i = 0; i < q.size(); ++i) {

@@ -120,15 +120,11 @@ Wavefront& SceneBench::render_wavefront() {
 
 std::size_t SceneBench::device_memory_bytes() {
   if (!device_bytes_) {
-    // The Wavefront does not report its buffers; their sizes follow from public pieces, the
-    // scene buffer from packing the scene again exactly as the Wavefront does.
+    // The Wavefront reports its scene buffers; the others' sizes follow from public pieces.
     Wavefront& wf = render_wavefront();
-    SceneExtras extras;
-    extras.lights = &wf.lights();
-    const std::size_t scene_bytes = pack_scene(scene_, bvh_, extras).bytes.size();
     const RenderSettings s = bench_settings(true);
     const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
-    device_bytes_ = scene_bytes + wf.path_state().bytes +
+    device_bytes_ = wf.scene_bytes() + wf.path_state().bytes +
                     WP_QUEUE_COUNT * wf.wave_size() * sizeof(dev::uint) +
                     WP_COUNTER_COUNT * sizeof(dev::uint) + 2 * pixels * sizeof(dev::float4);
   }

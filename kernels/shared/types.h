@@ -1,9 +1,9 @@
 /* Plain-old-data shared by the host and the kernels: scene records, the launch parameters and the
  * layouts of the two big device buffers (scene and path state). See compat.h for the rules.
  *
- * Every kernel takes the same first arguments: the scene buffer with its SceneDesc (byte offsets
- * of each array in it), the path-state buffer with its PathLayout, the queue buffers and a Launch.
- * Adding a scene array or a path field therefore changes no kernel signature.
+ * Every kernel takes the same first arguments: the scene buffers with their SceneDesc (where each
+ * array is), the path-state buffer with its PathLayout, the queue buffers and a Launch. Adding a
+ * scene array or a path field therefore changes no kernel signature.
  */
 #ifndef WP_SHARED_TYPES_H
 #define WP_SHARED_TYPES_H
@@ -16,8 +16,9 @@
 #define WP_MAT_ALPHA_MASK 2u  /* alphaMode MASK: a cutout at alpha_cutoff */
 #define WP_MAT_ALPHA_BLEND 4u /* alphaMode BLEND: present with probability alpha */
 #define WP_MAT_UNLIT 8u       /* KHR_materials_unlit: shows its base colour, scatters nothing */
-#define WP_MAT_VOLUME 16u /* KHR_materials_volume (thickness > 0): refraction, absorption inside \
-                           */
+#define WP_MAT_VOLUME                                                        \
+  16u /* KHR_materials_volume (thickness > 0): refraction, absorption inside \
+       */
 
 /* Texture wrap modes (TextureRef.meta.y, 8 bits each for S and T). */
 #define WP_WRAP_REPEAT 0u
@@ -48,8 +49,9 @@
 #define WP_QUEUE_SHADOW 3u  /* paths with a pending shadow ray */
 #define WP_QUEUE_COUNT 4u
 /* Counters after the queue counters. */
-#define WP_COUNTER_NONFINITE 4u /* NaN/Inf values dropped anywhere (must stay 0): film samples, \
-                                   path throughputs, light-sample contributions */
+#define WP_COUNTER_NONFINITE                                         \
+  4u /* NaN/Inf values dropped anywhere (must stay 0): film samples, \
+        path throughputs, light-sample contributions */
 #define WP_COUNTER_COUNT 5u
 
 WP_DEV_BEGIN
@@ -108,7 +110,16 @@ typedef struct Camera {
   uint4 meta;      /* x: WP_CAMERA_* type */
 } Camera;
 
-/* Where each scene array starts in the scene buffer (bytes, 64-aligned), and how many it holds. */
+/* The scene's arrays lie in up to WP_SCENE_BUFFERS device buffers, each no larger than the
+ * device's largest allocation (host/device_scene.h). Each array's place is one uint, its location:
+ * bits 0-2 the buffer, bits 3-31 the array's offset in it in 64-byte units, so
+ *   byte offset = (location >> 3) * 64 = (location & ~7) * 8
+ * and an array starts within the first 32 GiB of its buffer. */
+#define WP_SCENE_BUFFERS 8
+#define WP_SCENE_BUFFER_BITS 3
+#define WP_SCENE_ALIGN 64
+
+/* Where each scene array is (locations, above), and how many some of them hold. */
 typedef struct SceneDesc {
   Camera camera;
   float4 background; /* constant radiance of escaped rays (rgb) when there is no map */

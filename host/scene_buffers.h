@@ -1,0 +1,25 @@
+// The packed scene (device_scene.h) on a device, as the kernels' WP_SCENE_PARAMS take it
+// (kernels/scene.h): WP_SCENE_BUFFERS buffer arguments, then the SceneDesc.
+#pragma once
+
+#include <array>
+
+#include <CL/opencl.hpp>
+
+#include "host/device_scene.h"
+#include "kernels/shared/types.h"
+
+namespace wp {
+
+struct SceneBuffers {
+  std::array<cl::Buffer, WP_SCENE_BUFFERS> buffers;  // slots past the packed ones repeat the first
+  dev::SceneDesc desc{};
+};
+
+// Uploads `packed` (read-only buffers). Throws cl::Error as the allocation does.
+SceneBuffers upload_scene(const cl::Context& context, const PackedScene& packed);
+
+// Sets WP_SCENE_PARAMS as `kernel`'s arguments from index `first`; returns the index after them.
+cl_uint set_scene_args(cl::Kernel& kernel, cl_uint first, const SceneBuffers& scene);
+
+}  // namespace wp
