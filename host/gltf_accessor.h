@@ -9,9 +9,10 @@
 
 namespace wp::gltf {
 
-// Bit for a TINYGLTF_COMPONENT_TYPE_* value (5120..5126) in AccessorSpec::component_types.
+// Bit for a TINYGLTF_COMPONENT_TYPE_* value (5120..5126) in AccessorSpec::component_types; 0 for
+// any other value a file may hold (a shift by it would be undefined: found by fuzzing).
 constexpr unsigned component_bit(int component_type) {
-  return 1u << (component_type - 5120);
+  return component_type >= 5120 && component_type <= 5126 ? 1u << (component_type - 5120) : 0u;
 }
 
 constexpr unsigned kFloatBit = component_bit(TINYGLTF_COMPONENT_TYPE_FLOAT);

@@ -1085,6 +1085,31 @@ TEST(GltfLoader, ValidatorRejectionsAreErrors) {
     expect_error(g.write("nonfinite.gltf"), "accessor " + std::to_string(accessor) + " (" + name +
                                                 "): element 1 is not finite");
   }
+  // A componentType that is no glTF type, for an attribute or for sparse indices (fuzzing found
+  // 2561 in sparse indices shifting by a negative amount, caught only by UBSan).
+  for (int type : {-1, 0, 2561, 5119, 5127, 5152, 70000}) {
+    Gltf g;
+    const int base = g.view(std::vector<vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+    const int idx = g.view(std::vector<std::uint16_t>{1, 0});
+    const int val = g.view(std::vector<vec3>{{5, 5, 5}});
+    const std::string sparse =
+        ",\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":" + std::to_string(idx) +
+        ",\"componentType\":" + std::to_string(type) +
+        "},\"values\":{\"bufferView\":" + std::to_string(val) + "}}";
+    g.mesh({prim({{"POSITION", g.accessor(base, kF32, 3, "VEC3", sparse)}})});
+    g.node("\"mesh\":0", true);
+    expect_error(g.write("sparse_type.gltf"),
+                 "accessor 0 (POSITION) sparse: unsupported index "
+                 "component type " +
+                     std::to_string(type));
+    Gltf h;
+    h.mesh(
+        {prim({{"POSITION", h.accessor(h.view(std::vector<float>(9, 0.5f)), type, 3, "VEC3")}})});
+    h.node("\"mesh\":0", true);
+    // tinygltf refuses most such values itself ("Invalid `componentType`"), not 5127.
+    expect_error(h.write("attribute_type.gltf"),
+                 type == 5127 ? "unsupported component type 5127" : "omponentType");
+  }
 }
 
 // An empty scene is valid glTF: no nodes, only a camera, or only non-triangle primitives. It loads

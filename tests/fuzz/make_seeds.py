@@ -137,12 +137,19 @@ def triangle_scene(variant):
             {"attributes": {"POSITION": 0, "COLOR_0": 4}, "mode": 0},
             {"attributes": {"POSITION": 5}, "mode": 5},
             {"attributes": {"POSITION": 0, "TEXCOORD_1": 2}, "mode": 6, "material": 0}]}]
+    elif variant == "sparse_bad_type":
+        # Found by fuzzing (UBSan: a shift by componentType - 5120 < 0): the "modes" scene with
+        # sparse indices of componentType 2561. A seed, so every fuzz run replays it.
+        doc, buf = triangle_scene("modes")
+        doc["accessors"][5]["sparse"]["indices"]["componentType"] = 2561
+        return doc, buf
     doc["buffers"][0]["byteLength"] = len(buf)
     return doc, buf
 
 
 def builtin_gltf(out):
-    for variant in ("plain", "textured", "image_in_buffer", "extensions", "modes"):
+    for variant in ("plain", "textured", "image_in_buffer", "extensions", "modes",
+                    "sparse_bad_type"):
         doc, buf = triangle_scene(variant)
         with open(os.path.join(out, "builtin_%s.glb" % variant), "wb") as f:
             f.write(glb(doc, buf))
