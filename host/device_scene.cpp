@@ -177,15 +177,15 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
 
   PackedScene p;
   dev::SceneDesc& d = p.desc;
-  // The arrays in kArrayNames' order, each with the SceneDesc field of its location. The BVH is in
+  // The arrays in kArrayNames' order, each with the SceneDesc field of its offset. The BVH is in
   // the layout the program was built for (WP_BVH_WIDTH): the same two fields either way.
   struct Array {
     const void* data;
     std::uint64_t bytes;
-    dev::uint* location;
+    dev::uint* offset;
   };
-  const auto array = [](const auto& items, dev::uint& location) {
-    return Array{items.data(), items.size() * sizeof(items[0]), &location};
+  const auto array = [](const auto& items, dev::uint& offset) {
+    return Array{items.data(), items.size() * sizeof(items[0]), &offset};
   };
   std::vector<Array> arrays = {
       bvh.width == 8 ? array(bvh.nodes8, d.bvh_nodes) : array(bvh.nodes, d.bvh_nodes),
@@ -218,8 +218,9 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
     const SceneLayout::Place place = layout.places[i];
     if (arrays[i].bytes)
       std::memcpy(p.buffers[place.buffer].data() + place.offset, arrays[i].data, arrays[i].bytes);
-    *arrays[i].location = place.location();
+    *arrays[i].offset = static_cast<dev::uint>(place.offset / WP_SCENE_ALIGN);
   }
+  p.buffer_map = layout.buffer_map();
 
   d.camera = x.camera;
   d.background = f4(x.background);
@@ -235,9 +236,11 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
   return p;
 }
 
-dev::uint SceneLayout::Place::location() const {
-  return static_cast<dev::uint>(offset / WP_SCENE_ALIGN) << WP_SCENE_BUFFER_BITS |
-         static_cast<dev::uint>(buffer);
+std::uint64_t SceneLayout::buffer_map() const {
+  std::uint64_t map = 0;
+  for (std::size_t i = 0; i < places.size(); ++i)
+    map |= std::uint64_t(places[i].buffer) << (WP_SCENE_BUFFER_BITS * i);
+  return map;
 }
 
 std::uint64_t SceneLayout::total_bytes() const {

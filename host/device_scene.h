@@ -1,6 +1,7 @@
 // The scene as the device sees it: its arrays packed into up to WP_SCENE_BUFFERS byte buffers, each
-// no larger than the device's largest allocation, at 64-byte aligned offsets; a SceneDesc
-// (kernels/shared/types.h) records each array's location. Plus the device camera.
+// no larger than the device's largest allocation, at 64-byte aligned offsets. A SceneDesc
+// (kernels/shared/types.h) records each array's offset, the program's WP_SCENE_BUFFER_MAP its
+// buffer. Plus the device camera.
 #pragma once
 
 #include <cstdint>
@@ -19,10 +20,11 @@ namespace wp {
 struct PackedScene {
   std::vector<std::vector<unsigned char>> buffers;  // 1 to WP_SCENE_BUFFERS, uploaded as they are
   dev::SceneDesc desc{};
+  std::uint64_t buffer_map = 0;  // the program's WP_SCENE_BUFFER_MAP (SceneLayout::buffer_map)
 };
 
-// The most bytes one scene buffer may hold: a location's 29 bits of 64-byte units reach 32 GiB.
-inline constexpr std::uint64_t kSceneBufferReach = std::uint64_t(1) << 35;
+// The most bytes one scene buffer may hold: a uint of 64-byte units reaches 256 GiB.
+inline constexpr std::uint64_t kSceneBufferReach = std::uint64_t(1) << 38;
 
 // The device camera for an image of width x height. Perspective: image-plane half extents
 // tan(yfov/2) * aspect and tan(yfov/2) with aspect = width / height (glTF's convention: yfov is
@@ -50,12 +52,13 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
 struct SceneLayout {
   struct Place {
     int buffer = 0;
-    std::uint64_t offset = 0;    // bytes, a multiple of 64
-    dev::uint location() const;  // SceneDesc's encoding (kernels/shared/types.h)
+    std::uint64_t offset = 0;  // bytes, a multiple of WP_SCENE_ALIGN
   };
   std::vector<Place> places;                // per array
   std::vector<std::uint64_t> buffer_bytes;  // per buffer: where its last array ends (padded)
   std::uint64_t total_bytes() const;
+  // Each array's buffer in WP_SCENE_BUFFER_BITS bits, the first array's lowest (0: one buffer).
+  std::uint64_t buffer_map() const;
 };
 // The layout of arrays of `sizes` bytes. Throws wp::Error("scene too large for the device: ...")
 // naming the array when one alone exceeds max_buffer, or the total when more than

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "host/device_scene.h"
 #include "host/error.h"
@@ -77,6 +78,14 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     scene_ = upload_scene(ctx, packed);
     scene_buffer_count_ = static_cast<int>(packed.buffers.size());
     for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
+    // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
+    // buffer leaves the options as they were.
+    if (packed.buffer_map) {
+      char map[64];
+      std::snprintf(map, sizeof(map), " -D WP_SCENE_BUFFER_MAP=0x%llxul",
+                    static_cast<unsigned long long>(packed.buffer_map));
+      options_ += map;
+    }
     path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
     queue_slots_ =
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));

@@ -1,4 +1,4 @@
-/* The scene as kernels see it: typed pointers into the scene buffers (locations in SceneDesc). */
+/* The scene as kernels see it: typed pointers into the scene buffers (kernels/shared/types.h). */
 #ifndef WP_SCENE_H
 #define WP_SCENE_H
 
@@ -38,33 +38,43 @@ typedef struct SceneView {
                                                             scene4, scene5, scene6, scene7}; \
   const SceneView view = scene_bind(view##_buffers, &scene_desc)
 
-/* The first byte of the array at `location` (kernels/shared/types.h). */
-inline __global const uchar* scene_array(__global const uchar* const* buffers, uint location) {
-  return buffers[location & (WP_SCENE_BUFFERS - 1)] +
-         (ulong)(location & ~(uint)(WP_SCENE_BUFFERS - 1)) *
-             (WP_SCENE_ALIGN >> WP_SCENE_BUFFER_BITS);
+#ifndef WP_SCENE_BUFFER_MAP
+#define WP_SCENE_BUFFER_MAP 0 /* every array in buffer 0 */
+#endif
+/* The buffer holding array `i` (SceneDesc's order, from 0 for bvh_nodes): a compile-time constant.
+ */
+#define WP_SCENE_BUFFER_OF(i) \
+  ((uint)(((ulong)(WP_SCENE_BUFFER_MAP) >> (WP_SCENE_BUFFER_BITS * (i))) & (WP_SCENE_BUFFERS - 1)))
+
+/* The first byte of the array that starts `offset` 64-byte units into `buffers[buffer]`. */
+inline __global const uchar* scene_array(__global const uchar* const* buffers, uint buffer,
+                                         uint offset) {
+  return buffers[buffer] + (ulong)offset * WP_SCENE_ALIGN;
 }
+
+#define WP_SCENE_ARRAY(type, i, offset) \
+  ((__global const type*)scene_array(b, WP_SCENE_BUFFER_OF(i), d->offset))
 
 inline SceneView scene_bind(__global const uchar* const* b, const SceneDesc* d) {
   SceneView s;
-  s.nodes = (__global const BvhNode*)scene_array(b, d->bvh_nodes);
-  s.tris = (__global const IsectTri*)scene_array(b, d->isect_tris);
-  s.tri_vertices = (__global const uint4*)scene_array(b, d->tri_vertices);
-  s.positions = (__global const float4*)scene_array(b, d->positions);
-  s.normals = (__global const float4*)scene_array(b, d->normals);
-  s.tangents = (__global const float4*)scene_array(b, d->tangents);
-  s.uvs = (__global const float4*)scene_array(b, d->uvs);
-  s.colors = (__global const float4*)scene_array(b, d->colors);
-  s.materials = (__global const Material*)scene_array(b, d->materials);
-  s.textures = (__global const TextureRef*)scene_array(b, d->textures);
-  s.images = (__global const TextureImage*)scene_array(b, d->images);
-  s.texels = (__global const uint*)scene_array(b, d->texels);
-  s.lights = (__global const Light*)scene_array(b, d->lights);
-  s.light_alias = (__global const LightAlias*)scene_array(b, d->light_alias);
-  s.tri_light = (__global const uint*)scene_array(b, d->tri_light);
-  s.env_texels = (__global const float4*)scene_array(b, d->env_texels);
-  s.env_marginal = (__global const float*)scene_array(b, d->env_marginal);
-  s.env_conditional = (__global const float*)scene_array(b, d->env_conditional);
+  s.nodes = WP_SCENE_ARRAY(BvhNode, 0, bvh_nodes);
+  s.tris = WP_SCENE_ARRAY(IsectTri, 1, isect_tris);
+  s.tri_vertices = WP_SCENE_ARRAY(uint4, 2, tri_vertices);
+  s.positions = WP_SCENE_ARRAY(float4, 3, positions);
+  s.normals = WP_SCENE_ARRAY(float4, 4, normals);
+  s.tangents = WP_SCENE_ARRAY(float4, 5, tangents);
+  s.uvs = WP_SCENE_ARRAY(float4, 6, uvs);
+  s.colors = WP_SCENE_ARRAY(float4, 7, colors);
+  s.materials = WP_SCENE_ARRAY(Material, 8, materials);
+  s.textures = WP_SCENE_ARRAY(TextureRef, 9, textures);
+  s.images = WP_SCENE_ARRAY(TextureImage, 10, images);
+  s.texels = WP_SCENE_ARRAY(uint, 11, texels);
+  s.lights = WP_SCENE_ARRAY(Light, 12, lights);
+  s.light_alias = WP_SCENE_ARRAY(LightAlias, 13, light_alias);
+  s.tri_light = WP_SCENE_ARRAY(uint, 14, tri_light);
+  s.env_texels = WP_SCENE_ARRAY(float4, 15, env_texels);
+  s.env_marginal = WP_SCENE_ARRAY(float, 16, env_marginal);
+  s.env_conditional = WP_SCENE_ARRAY(float, 17, env_conditional);
   s.desc = d;
   return s;
 }

@@ -118,14 +118,17 @@ TEST(PackedSize, LayoutAgreesWithPackScene) {
         if (max_buffer < one) {
           EXPECT_GE(packed.buffers.size(), 3u);
         }
-        const dev::uint locations[] = {packed.desc.bvh_nodes,    packed.desc.isect_tris,
-                                       packed.desc.tri_vertices, packed.desc.positions,
-                                       packed.desc.tri_light,    packed.desc.env_conditional};
+        EXPECT_EQ(packed.buffer_map, layout.buffer_map());
+        EXPECT_EQ(packed.buffer_map != 0, packed.buffers.size() > 1);
+        const dev::uint offsets[] = {packed.desc.bvh_nodes,    packed.desc.isect_tris,
+                                     packed.desc.tri_vertices, packed.desc.positions,
+                                     packed.desc.tri_light,    packed.desc.env_conditional};
         const std::size_t indices[] = {0, 1, 2, 3, 14, 17};
-        for (std::size_t k = 0; k < std::size(indices); ++k)
+        for (std::size_t k = 0; k < std::size(indices); ++k) {
           if (indices[k] < layout.places.size()) {
-            EXPECT_EQ(locations[k], layout.places[indices[k]].location()) << "array " << k;
+            EXPECT_EQ(offsets[k] * std::uint64_t(64), layout.places[indices[k]].offset) << k;
           }
+        }
         EXPECT_EQ(packed.desc.triangle_count, 300u);
       }
     }
@@ -133,7 +136,8 @@ TEST(PackedSize, LayoutAgreesWithPackScene) {
 }
 
 // Each array starts on a 64-byte boundary, never crosses the end of a buffer, and starts a new
-// buffer only when it would cross; locations encode buffer and offset; refusals name the cause.
+// buffer only when it would cross; the buffer map holds each array's buffer; refusals name the
+// cause.
 TEST(PackedSize, ArraysAreSplitOverBuffersWithoutCrossingOne) {
   const std::vector<std::uint64_t> sizes = {1000, 0, 5, 3000, 64, 4096, 1, 2500, 777, 0};
   for (std::uint64_t max_buffer : {4096u, 5000u, 8192u, 100000u}) {
@@ -155,7 +159,7 @@ TEST(PackedSize, ArraysAreSplitOverBuffersWithoutCrossingOne) {
       buffer = p.buffer;
       end = p.offset + size;
       EXPECT_LE(end, max_buffer);
-      EXPECT_EQ(p.location(), dev::uint(p.offset / 64) << 3 | dev::uint(p.buffer));
+      EXPECT_EQ(layout.buffer_map() >> (3 * i) & 7, std::uint64_t(p.buffer));
       EXPECT_EQ(layout.buffer_bytes[p.buffer], std::max(layout.buffer_bytes[p.buffer], end));
     }
     EXPECT_EQ(layout.buffer_bytes.size(), std::size_t(buffer) + 1);
@@ -169,11 +173,11 @@ TEST(PackedSize, ArraysAreSplitOverBuffersWithoutCrossingOne) {
   EXPECT_EQ(error_of([&] { plan_scene_layout(nine, kGiB); }),
             "scene too large for the device: 9.00 GiB does not fit in 8 buffers of at most "
             "1.00 GiB (the device's largest buffer)");
-  // A location reaches 32 GiB into a buffer: larger limits are capped there.
-  const SceneLayout far = plan_scene_layout({20 * kGiB, 12 * kGiB, 1}, 64 * kGiB);
-  EXPECT_EQ(far.places[1].offset, 20 * kGiB);
+  // A uint of 64-byte units reaches 256 GiB into a buffer: larger limits are capped there.
+  const SceneLayout far = plan_scene_layout({200 * kGiB, 56 * kGiB, 1}, 1024 * kGiB);
+  EXPECT_EQ(far.places[1].offset, 200 * kGiB);
   EXPECT_EQ(far.places[2].buffer, 1);
-  EXPECT_EQ(far.places[1].location(), dev::uint(20 * kGiB / 64) << 3);
+  EXPECT_EQ(far.buffer_map(), std::uint64_t(1) << 6);
 }
 
 // The BVH estimate used before the build is at most what any build makes: both layouts, with and

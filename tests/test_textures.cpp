@@ -15,6 +15,7 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <stdexcept>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -40,7 +41,10 @@ wp::SceneBuffers upload(const wp::Scene& s, wp::test::KernelHarness& h = harness
   const wp::LightTable lights;
   wp::SceneExtras extras;
   extras.lights = &lights;
-  return wp::upload_scene(h.runtime().context(), wp::pack_scene(s, wp::bvh::Bvh{}, extras));
+  const wp::PackedScene p = wp::pack_scene(s, wp::bvh::Bvh{}, extras);
+  // The test program is built without WP_SCENE_BUFFER_MAP: everything in buffer 0.
+  if (p.buffers.size() != 1) throw std::logic_error("test scene split over several buffers");
+  return wp::upload_scene(h.runtime().context(), p);
 }
 
 float4 f4(glm::vec4 v) {

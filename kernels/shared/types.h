@@ -111,15 +111,16 @@ typedef struct Camera {
 } Camera;
 
 /* The scene's arrays lie in up to WP_SCENE_BUFFERS device buffers, each no larger than the
- * device's largest allocation (host/device_scene.h). Each array's place is one uint, its location:
- * bits 0-2 the buffer, bits 3-31 the array's offset in it in 64-byte units, so
- *   byte offset = (location >> 3) * 64 = (location & ~7) * 8
- * and an array starts within the first 32 GiB of its buffer. */
+ * device's largest allocation (host/device_scene.h). Which buffer holds an array is fixed when the
+ * program is built: WP_SCENE_BUFFER_MAP (kernels/scene.h), WP_SCENE_BUFFER_BITS per array in
+ * SceneDesc's order, so every scene pointer is one kernel argument plus an offset (a buffer index
+ * known only at run time made every kernel 12% slower on PoCL). The offset of each array in its
+ * buffer is in SceneDesc, in units of WP_SCENE_ALIGN bytes: a uint reaches 256 GiB. */
 #define WP_SCENE_BUFFERS 8
 #define WP_SCENE_BUFFER_BITS 3
 #define WP_SCENE_ALIGN 64
 
-/* Where each scene array is (locations, above), and how many some of them hold. */
+/* Where each scene array starts in its buffer (64-byte units, above), and how many some hold. */
 typedef struct SceneDesc {
   Camera camera;
   float4 background; /* constant radiance of escaped rays (rgb) when there is no map */
