@@ -26,12 +26,15 @@ import rgbe  # noqa: E402  (scenes/rgbe.py: flat RGBE writing)
 MAX_SEED = 64 * 1024  # bytes; larger inputs mostly slow the fuzzer down
 
 
-def png_rgba(width, height, pixel):
+def png_rgba(width, height, pixel, empty_idat=False):
+    """A width x height RGBA8 PNG of one colour; `empty_idat` puts a zero-length IDAT chunk first
+    (valid PNG; stb_image then copies zero bytes to a null pointer, a fuzz finding)."""
     def chunk(kind, data):
         return struct.pack(">I", len(data)) + kind + data + struct.pack(
             ">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
     raw = b"".join(b"\0" + bytes(pixel) * width for _ in range(height))
     return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
+            + (chunk(b"IDAT", b"") if empty_idat else b"")
             + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
@@ -137,6 +140,12 @@ def triangle_scene(variant):
             {"attributes": {"POSITION": 0, "COLOR_0": 4}, "mode": 0},
             {"attributes": {"POSITION": 5}, "mode": 5},
             {"attributes": {"POSITION": 0, "TEXCOORD_1": 2}, "mode": 6, "material": 0}]}]
+    elif variant == "png_empty_idat":
+        doc, buf = triangle_scene("plain")
+        doc["images"] = [{"uri": data_uri("image/png", png_rgba(2, 2, (9, 8, 7, 255), True))}]
+        doc["textures"] = [{"source": 0}]
+        doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+        return doc, buf
     elif variant == "sparse_bad_type":
         # Found by fuzzing (UBSan: a shift by componentType - 5120 < 0): the "modes" scene with
         # sparse indices of componentType 2561. A seed, so every fuzz run replays it.
@@ -149,7 +158,7 @@ def triangle_scene(variant):
 
 def builtin_gltf(out):
     for variant in ("plain", "textured", "image_in_buffer", "extensions", "modes",
-                    "sparse_bad_type"):
+                    "sparse_bad_type", "png_empty_idat"):
         doc, buf = triangle_scene(variant)
         with open(os.path.join(out, "builtin_%s.glb" % variant), "wb") as f:
             f.write(glb(doc, buf))
