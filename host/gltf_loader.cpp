@@ -19,6 +19,7 @@
 #include <tiny_gltf.h>
 
 #include "host/error.h"
+#include "host/fnv1a.h"
 #include "host/gltf_material.h"
 #include "host/gltf_nodes.h"
 #include "host/gltf_primitive.h"
@@ -133,9 +134,11 @@ void check_json_depth(const unsigned char* text, std::size_t size) {
 }
 
 // Parses the file with tinygltf (.glb when it starts with the binary magic, else JSON text);
-// tinygltf's warnings go to `warnings`, one line each.
-tinygltf::Model parse(const std::string& path, std::vector<std::string>* warnings) {
+// tinygltf's warnings go to `warnings`, one line each; the file's FNV-1a digest to `digest`.
+tinygltf::Model parse(const std::string& path, std::vector<std::string>* warnings,
+                      std::uint64_t* digest) {
   const std::vector<unsigned char> bytes = read_file(path);
+  *digest = fnv1a64(bytes.data(), bytes.size());
   const bool glb = has_glb_magic(bytes);
   const std::string ext = std::filesystem::path(path).extension().string();
   if (!glb && (ext == ".glb" || ext == ".GLB"))
@@ -344,7 +347,13 @@ void compute_bounds(Scene& scene) {
 Scene load_gltf(const std::string& path) {
   Scene scene;
   scene.source = path;
-  const tinygltf::Model model = parse(path, &scene.warnings);
+  const tinygltf::Model model = parse(path, &scene.warnings, &scene.digest);
+  // The files the glTF file names (a GLB's own binary chunk is in its digest already).
+  for (const tinygltf::Buffer& b : model.buffers)
+    if (!b.uri.empty()) scene.digest = fnv1a64(b.data.data(), b.data.size(), scene.digest);
+  for (const tinygltf::Image& image : model.images)  // encoded bytes (keep_encoded_image)
+    if (image.bufferView < 0)
+      scene.digest = fnv1a64(image.image.data(), image.image.size(), scene.digest);
   check_extensions(model, path, &scene.warnings);
   try {
     // glTF 1.0 files differ in structure; tinygltf reads some of them as 2.0 nonsense.

@@ -170,46 +170,55 @@ unsigned char png_encode(float linear, const PngOptions& png) {
   return static_cast<unsigned char>(std::lround(s * 255.0f));
 }
 
-void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
-                  const std::map<std::string, std::string>& exr_attributes, const PngOptions& png,
-                  const ImageRgb* variance) {
-  std::vector<std::string> all = paths;
+std::vector<OutputFile> image_files(const std::vector<std::string>& paths, const ImageRgb& image,
+                                    const std::map<std::string, std::string>& exr_attributes,
+                                    const PngOptions& png, const ImageRgb* variance) {
+  // The lambdas refer to the caller's image, attributes and options, which outlive write_files.
+  std::vector<OutputFile> files;
   for (const auto& path : paths) {
     const std::string ext = extension_of(path);
-    if (ext != ".exr" && ext != ".png" && ext != ".pfm")
+    if (ext == ".exr")
+      files.push_back({path, [&image, &exr_attributes, variance](const std::string& temp) {
+                         write_exr(temp, image, exr_attributes, variance);
+                       }});
+    else if (ext == ".png")
+      files.push_back(
+          {path, [&image, &png](const std::string& temp) { write_png(temp, image, png); }});
+    else if (ext == ".pfm")
+      files.push_back({path, [&image](const std::string& temp) { write_pfm(temp, image); }});
+    else
       throw Error(path + ": unsupported output format (use .exr, .png or .pfm)");
-    if (ext == ".pfm" && variance) all.push_back(variance_path(path));
+    if (ext == ".pfm" && variance)
+      files.push_back({variance_path(path),
+                       [variance](const std::string& temp) { write_pfm(temp, *variance); }});
   }
+  return files;
+}
+
+void write_files(const std::vector<OutputFile>& files) {
   // Every temporary name is chosen before the first is created, so that an interruption at any
   // point finds all of them registered with the signal handler.
   std::vector<std::string> temps;
-  for (const auto& path : all) temps.push_back(temporary_name(path));
+  for (const auto& file : files) temps.push_back(temporary_name(file.path));
   const TempFileGuard guard(temps);
   std::size_t current = 0;  // the file being written, for messages
   try {
-    for (; current < all.size(); ++current) {
-      const std::string& path = all[current];
-      const std::string& temp = temps[current];
-      const std::string ext = extension_of(path);
-      if (ext == ".exr")
-        write_exr(temp, image, exr_attributes, variance);
-      else if (ext == ".png")
-        write_png(temp, image, png);
-      else if (variance && path.size() > 13 &&
-               path.compare(path.size() - 13, 13, ".variance.pfm") == 0 &&
-               std::find(paths.begin(), paths.end(), path) == paths.end())
-        write_pfm(temp, *variance);
-      else
-        write_pfm(temp, image);
-    }
+    for (; current < files.size(); ++current) files[current].write(temps[current]);
     const BlockSignals block;
-    for (current = 0; current < all.size(); ++current)
-      std::filesystem::rename(temps[current], all[current]);
+    for (current = 0; current < files.size(); ++current)
+      std::filesystem::rename(temps[current], files[current].path);
   } catch (const std::exception& e) {
     for (const auto& t : temps) std::remove(t.c_str());  // also those not (yet) created: harmless
     if (dynamic_cast<const Error*>(&e)) throw;
-    throw Error("cannot write " + all[std::min(current, all.size() - 1)] + ": " + e.what());
+    throw Error("cannot write " + files[std::min(current, files.size() - 1)].path + ": " +
+                e.what());
   }
+}
+
+void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
+                  const std::map<std::string, std::string>& exr_attributes, const PngOptions& png,
+                  const ImageRgb* variance) {
+  write_files(image_files(paths, image, exr_attributes, png, variance));
 }
 
 ImageRgb read_exr(const std::string& path, const std::string& layer) {

@@ -5,6 +5,7 @@
 // and overwrites nothing.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -22,6 +23,25 @@ struct PngOptions {
   float exposure = 0.0f;  // stops: the image is scaled by 2^exposure before tonemapping
   Tonemap tonemap = Tonemap::kAces;
 };
+
+// One output file: `write` writes its content to the path it is given (a temporary name beside
+// `path`), throwing on failure.
+struct OutputFile {
+  std::string path;
+  std::function<void(const std::string& temp_path)> write;
+};
+
+// Writes `files` atomically as a set: each under a temporary name beside its destination, then,
+// once all are complete, renamed into place (with SIGINT, SIGTERM and SIGHUP blocked). On failure
+// or on one of those signals the temporary files are removed and nothing is replaced. Throws
+// wp::Error naming the file.
+void write_files(const std::vector<OutputFile>& files);
+
+// The image outputs among `paths` (.exr, .png, .pfm; with `variance`, a .pfm's companion
+// .variance.pfm) as OutputFiles for write_files. Throws wp::Error for any other extension.
+std::vector<OutputFile> image_files(const std::vector<std::string>& paths, const ImageRgb& image,
+                                    const std::map<std::string, std::string>& exr_attributes,
+                                    const PngOptions& png = {}, const ImageRgb* variance = nullptr);
 
 // Writes each of `paths` (by extension: .exr or .png) atomically as a set. Throws wp::Error naming
 // the file on failure (an unknown extension, an unwritable folder), after removing what it wrote.

@@ -8,8 +8,9 @@
 //   triangle: pi A L (twice that when double-sided);  environment: 4 pi^2 r^2 L_mean;
 // with luminances of the RGB values, r the radius of the scene's bounding sphere, A the area, L
 // the emitted radiance averaged over the triangle (host/emission.h: an emissive texture is
-// integrated; a triangle that is black everywhere is not a light). The pmf of every light is stored too: MIS needs the probability with which
-// NEE would have chosen a light that a BSDF-sampled ray found.
+// integrated; a triangle that is black everywhere is not a light). The pmf of every light is stored
+// too: MIS needs the probability with which NEE would have chosen a light that a BSDF-sampled ray
+// found.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,5 @@
-// wavepath: the command line. `wavepath render SCENE` and `wavepath devices`.
+// wavepath: the command line. `wavepath render SCENE`, `wavepath merge FILM...` and
+// `wavepath devices`.
 // Errors of every kind end here, in one place: one line on stderr, exit status 1.
 #include <unistd.h>
 
@@ -19,6 +20,7 @@
 #include "host/cl_runtime.h"
 #include "host/environment.h"
 #include "host/error.h"
+#include "host/film.h"
 #include "host/gltf_loader.h"
 #include "host/render.h"
 #include "host/report_json.h"
@@ -27,7 +29,9 @@ namespace {
 
 struct CliOptions {
   std::string scene;
+  std::vector<std::string> parts;  // merge: the .wpfilm files
   std::vector<std::string> outputs;
+  std::string samples;  // --samples A:B
   std::string device;
   std::vector<float> env_color{0.0f, 0.0f, 0.0f};
   std::string env;
@@ -64,16 +68,25 @@ int list_devices() {
   return 0;
 }
 
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+bool is_film(const std::string& path) {
+  return extension_of(path) == ".wpfilm";
+}
+
 // Fails before any rendering when an output could not be written at the end: outputs are written
 // beside their destination under a temporary name and renamed into place (image_io.h), which
 // needs a writable folder; an existing file that is not writable is not replaced either.
 void check_outputs(const std::vector<std::string>& outputs) {
   for (const auto& o : outputs) {
     const std::filesystem::path p(o);
-    std::string ext = p.extension().string();
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".exr" && ext != ".png" && ext != ".pfm")
-      throw wp::Error(o + ": unsupported output format (use .exr, .png or .pfm)");
+    const std::string ext = extension_of(o);
+    if (ext != ".exr" && ext != ".png" && ext != ".pfm" && ext != ".wpfilm")
+      throw wp::Error(o + ": unsupported output format (use .exr, .png, .pfm or .wpfilm)");
     const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
     if (!std::filesystem::is_directory(dir))
       throw wp::Error(o + ": folder " + dir.string() + " does not exist");
@@ -86,6 +99,32 @@ void check_outputs(const std::vector<std::string>& outputs) {
     if (std::filesystem::exists(status) && access(p.c_str(), W_OK) != 0)
       throw wp::Error(o + ": the existing file is not writable (" + std::strerror(errno) + ")");
   }
+}
+
+// --samples A:B (0 <= A < B <= 2^20) into settings.sample_begin and settings.spp. --spp N means
+// 0:N, so both may be given only when they name the same range.
+void apply_samples(const CLI::App& render, const CliOptions& cli, wp::RenderSettings& settings) {
+  if (render.count("--samples") == 0) return;
+  const std::string& text = cli.samples;
+  const auto bad = [&] {
+    return wp::Error("--samples " + text +
+                     ": expected A:B with 0 <= A < B <= " + std::to_string(WP_FILM_MAX_SAMPLES));
+  };
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos) throw bad();
+  const auto whole = [&](const std::string& digits) {
+    if (digits.empty() || digits.size() > 8 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      throw bad();
+    return std::stoi(digits);
+  };
+  const int begin = whole(text.substr(0, colon)), end = whole(text.substr(colon + 1));
+  if (!(begin < end && end <= int(WP_FILM_MAX_SAMPLES))) throw bad();
+  if (render.count("--spp") && !(begin == 0 && end == settings.spp))
+    throw wp::Error("--spp " + std::to_string(settings.spp) + " and --samples " + text +
+                    " disagree (--spp N means --samples 0:N); give one of them");
+  settings.sample_begin = begin;
+  settings.spp = end - begin;
 }
 
 // Ranges CLI11 cannot express and wp::validate (render.h) does not cover: these are the command
@@ -124,9 +163,28 @@ class Progress {
   bool enabled_;
 };
 
+// Writes every output as one set (image_io.h, write_files): images by extension from `film`'s
+// mean (and variance), .wpfilm files from `film` itself.
+void write_outputs(const CliOptions& cli, const wp::Film& film, const wp::ImageRgb& image,
+                   const wp::ImageRgb& variance,
+                   const std::map<std::string, std::string>& exr_attributes) {
+  wp::PngOptions png;
+  png.exposure = cli.exposure;
+  png.tonemap = cli.tonemap == "clamp" ? wp::Tonemap::kClamp : wp::Tonemap::kAces;
+  std::vector<std::string> images;
+  for (const auto& o : cli.outputs)
+    if (!is_film(o)) images.push_back(o);
+  std::vector<wp::OutputFile> files =
+      wp::image_files(images, image, exr_attributes, png, cli.variance ? &variance : nullptr);
+  for (const auto& o : cli.outputs)
+    if (is_film(o)) files.push_back({o, [&film](const std::string& temp) { film.write(temp); }});
+  wp::write_files(files);
+}
+
 int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings) {
   if (cli.outputs.empty()) cli.outputs = {"render.exr", "render.png"};
   check_outputs(cli.outputs);
+  apply_samples(render, cli, settings);
   check_options(render, cli, settings);
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
@@ -161,12 +219,9 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   options.progress = Progress(!cli.quiet && isatty(STDERR_FILENO));
   const wp::Rendered result = wp::render(runtime, scene, settings, options);
 
-  wp::PngOptions png;
-  png.exposure = cli.exposure;
-  png.tonemap = cli.tonemap == "clamp" ? wp::Tonemap::kClamp : wp::Tonemap::kAces;
-  wp::write_images(cli.outputs, result.image,
-                   wp::exr_attributes(cli.scene, settings, result.report), png,
-                   cli.variance ? &result.variance : nullptr);
+  auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
+  attributes["wavepath:render_key"] = result.film.info().key;
+  write_outputs(cli, result.film, result.image, result.variance, attributes);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (result.report.nonfinite_samples > 0)
@@ -175,10 +230,70 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   if (cli.json)
     std::cout << wp::report_json(settings, result.report, load_seconds, total, cli.outputs) << "\n";
   else if (!cli.quiet)
-    std::fprintf(stderr, "wavepath: %s: %d spp in %.2f s (%.3g samples/s) on %s; wrote %s\n",
-                 cli.scene.c_str(), settings.spp, result.report.render_seconds,
+    std::fprintf(stderr,
+                 "wavepath: %s: %d spp (samples %d:%d) in %.2f s (%.3g samples/s) on %s; wrote "
+                 "%s\n",
+                 cli.scene.c_str(), settings.spp, settings.sample_begin,
+                 settings.sample_begin + settings.spp, result.report.render_seconds,
                  result.report.samples_per_second(settings), result.report.device.c_str(),
                  cli.outputs.front().c_str());
+  return 0;
+}
+
+// `wavepath merge`: films of one render's sample ranges, in any order, into one. Every part is
+// read and checked (Film::read_info: without keeping its data) before anything is added or
+// written: the same render key and size as the first part's, and ranges that neither overlap nor
+// leave a gap (once sorted). Then the films are read again and added one at a time, in sample
+// order, so that at most two are in memory.
+int merge_command(CliOptions& cli) {
+  check_outputs(cli.outputs);
+  std::vector<wp::FilmInfo> parts;
+  for (const auto& part : cli.parts) parts.push_back(wp::Film::read_info(part));
+  for (std::size_t i = 1; i < parts.size(); ++i) {
+    const std::string problem = wp::film_identity_problem(parts[0], parts[i]);
+    if (!problem.empty())
+      throw wp::Error(cli.parts[i] + " does not merge with " + cli.parts[0] + ": " + problem);
+  }
+  std::vector<std::size_t> order(parts.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return parts[a].sample_begin < parts[b].sample_begin;
+  });
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const std::string problem = wp::film_merge_problem(parts[order[k - 1]], parts[order[k]]);
+    if (!problem.empty())
+      throw wp::Error(cli.parts[order[k - 1]] + " and " + cli.parts[order[k]] +
+                      " do not merge: " + problem);
+  }
+  wp::Film merged = wp::Film::read(cli.parts[order[0]]);
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const std::string& part = cli.parts[order[k]];
+    try {  // the file may have changed since its header was checked
+      merged.add(wp::Film::read(part));
+    } catch (const wp::Error& e) {
+      if (std::string(e.what()).rfind(part, 0) == 0) throw;
+      throw wp::Error(part + ": " + e.what());
+    }
+  }
+  const wp::FilmInfo& info = merged.info();
+  wp::FilmImages images = merged.images();
+  const wp::ImageRgb image{info.width, info.height, std::move(images.mean)};
+  const wp::ImageRgb variance{info.width, info.height, std::move(images.variance)};
+  write_outputs(cli, merged, image, variance, wp::film_exr_attributes(info));
+  if (cli.json) {
+    std::cout << "{\"parts\":" << parts.size() << ",\"spp\":" << info.samples()
+              << ",\"sample_begin\":" << info.sample_begin << ",\"sample_end\":" << info.sample_end
+              << ",\"width\":" << info.width << ",\"height\":" << info.height
+              << ",\"device\":" << wp::json_string(info.device)
+              << ",\"nonfinite_samples\":" << info.nonfinite_samples << ",\"outputs\":[";
+    for (std::size_t i = 0; i < cli.outputs.size(); ++i)
+      std::cout << (i ? "," : "") << wp::json_string(cli.outputs[i]);
+    std::cout << "]}\n";
+  } else if (!cli.quiet) {
+    std::fprintf(stderr, "wavepath: merged %zu film(s): samples %u:%u, %dx%d; wrote %s\n",
+                 parts.size(), info.sample_begin, info.sample_end, info.width, info.height,
+                 cli.outputs.front().c_str());
+  }
   return 0;
 }
 
@@ -202,11 +317,17 @@ int main(int argc, char** argv) {
   render->add_option("scene", cli.scene, "glTF 2.0 file (.gltf or .glb)")->required();
   render->add_option("-o,--output", cli.outputs,
                      "Output file(s): .exr = linear float RGB with the settings in its header, "
-                     ".png = 8-bit sRGB preview, .pfm = linear float RGB (Portable FloatMap) "
-                     "[default: render.exr render.png]");
+                     ".png = 8-bit sRGB preview, .pfm = linear float RGB (Portable FloatMap), "
+                     ".wpfilm = the film's exact sums, to merge with other sample ranges "
+                     "(wavepath merge) [default: render.exr render.png]");
   render->add_option("--width", settings.width, "Image width in pixels")->capture_default_str();
   render->add_option("--height", settings.height, "Image height in pixels")->capture_default_str();
-  render->add_option("--spp", settings.spp, "Samples per pixel")->capture_default_str();
+  render->add_option("--spp", settings.spp, "Samples per pixel (the same as --samples 0:N)")
+      ->capture_default_str();
+  render->add_option("--samples", cli.samples,
+                     "Render only sample indices A to B-1 (0 <= A < B <= 1048576), a part of a "
+                     "longer render: its .wpfilm output merges exactly with the other parts' "
+                     "(wavepath merge); the image is the mean of these samples [default: 0:spp]");
   render->add_option("--camera", settings.camera,
                      "Camera index in node order [default: the first, else one framing the scene]");
   render
@@ -276,10 +397,34 @@ int main(int argc, char** argv) {
                    "layer variance.R/G/B in EXR output, X.variance.pfm beside X.pfm");
   render->add_flag("--profile", settings.profile, "Time each kernel (adds stage times to --json)");
   render->add_flag("--json", cli.json,
-                   "Print a JSON summary as the last line of stdout (spp, width, height, "
-                   "seconds, samples_per_second, device, triangles, kernel_build_seconds, "
-                   "bvh_build_seconds, ...)");
+                   "Print a JSON summary as the last line of stdout (spp, sample_begin, "
+                   "sample_end, width, height, seconds, samples_per_second, device, triangles, "
+                   "kernel_build_seconds, bvh_build_seconds, ...)");
   render->add_flag("-q,--quiet", cli.quiet, "No progress or warnings on stderr");
+
+  CLI::App* merge = app.add_subcommand(
+      "merge",
+      "Merge .wpfilm films of one render's sample ranges (any order) into one film or image");
+  merge
+      ->add_option("films", cli.parts,
+                   ".wpfilm files of the same render (scene and settings) and size whose sample "
+                   "ranges (--samples) together form one range, without overlaps or gaps")
+      ->required();
+  merge
+      ->add_option("-o,--output", cli.outputs,
+                   "Output file(s): .exr, .png, .pfm (the merged image) and/or .wpfilm (the merged "
+                   "film)")
+      ->required();
+  merge->add_option("--tonemap", cli.tonemap, "PNG tonemap: aces or clamp")
+      ->check(CLI::IsMember({"aces", "clamp"}))
+      ->capture_default_str();
+  merge->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
+  merge->add_flag("--variance", cli.variance,
+                  "Also write the variance of each pixel's estimate (as render --variance)");
+  merge->add_flag("--json", cli.json,
+                  "Print a JSON summary (parts, spp, sample_begin, sample_end, width, height, "
+                  "device, nonfinite_samples, outputs) as the last line of stdout");
+  merge->add_flag("-q,--quiet", cli.quiet, "No summary on stderr");
 
   try {
     app.parse(argc, argv);
@@ -290,6 +435,11 @@ int main(int argc, char** argv) {
   }
   try {
     if (devices->parsed()) return list_devices();
+    if (merge->parsed()) {
+      if (!std::isfinite(cli.exposure) || std::abs(cli.exposure) > 64.0f)
+        throw wp::Error("--exposure must be a finite number of stops between -64 and 64");
+      return merge_command(cli);
+    }
     return render_command(*render, cli, settings);
   } catch (const wp::Error& e) {
     std::cerr << "wavepath: error: " << e.what() << "\n";

@@ -2,10 +2,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <sstream>
 
 #include "bvh/bvh_cache.h"
 #include "host/device_scene.h"
 #include "host/error.h"
+#include "host/fnv1a.h"
 
 namespace wp {
 
@@ -22,6 +25,8 @@ void validate(const RenderSettings& s) {
   check(s.width >= 1 && s.width <= 16384, "--width must be between 1 and 16384");
   check(s.height >= 1 && s.height <= 16384, "--height must be between 1 and 16384");
   check(s.spp >= 1, "--spp must be at least 1");
+  check(s.sample_begin >= 0 && s.spp <= int(WP_FILM_MAX_SAMPLES) - s.sample_begin,
+        "--samples: the sample indices must lie within 0:1048576");
   check(s.max_depth >= 0 && s.max_depth <= 1024, "--max-depth must be between 0 and 1024");
   check(s.rr_depth >= 0, "--rr-depth must be at least 0");
   check(s.bvh_width == 0 || s.bvh_width == 2 || s.bvh_width == 8, "--bvh-width must be 2 or 8");
@@ -48,6 +53,37 @@ bvh::BuildInput bvh_input(const Scene& scene, std::vector<std::uint32_t>& flags)
   }
   input.triangle_flags = flags.data();
   return input;
+}
+
+std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_width,
+                       bool spatial_splits, std::uint64_t kernel_digest) {
+  const auto num = [](float v) {  // 9 significant digits: every float reads back exactly
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", static_cast<double>(v));
+    return std::string(buf);
+  };
+  std::string env = "none";
+  if (s.environment) {
+    std::uint64_t h = kFnv1aOffset;
+    for (const glm::vec4& t : s.environment->texels) h = fnv1a64(&t[0], 3 * sizeof(float), h);
+    env = std::to_string(s.environment->width) + "x" + std::to_string(s.environment->height) + ":" +
+          hex64(h);
+  }
+  std::ostringstream k;
+  k << "scene=" << hex64(scene.digest) << ";env=" << env << ";width=" << s.width
+    << ";height=" << s.height << ";max_depth=" << s.max_depth << ";rr_depth=" << s.rr_depth
+    << ";seed=" << s.seed << ";background=" << num(s.background.x) << "," << num(s.background.y)
+    << "," << num(s.background.z) << ";env_intensity=" << num(s.env_intensity)
+    << ";env_rotation=" << num(s.env_rotation) << ";strategy="
+    << (s.strategy == Strategy::kMis   ? "mis"
+        : s.strategy == Strategy::kNee ? "nee"
+                                       : "bsdf")
+    << ";mis_heuristic=" << (s.mis_heuristic == MisHeuristic::kPower ? "power" : "balance")
+    << ";light_select=" << (s.light_select == LightSelect::kPower ? "power" : "uniform")
+    << ";camera=" << s.camera << ";features=" << (s.all_features ? "all" : "scene")
+    << ";bvh_width=" << bvh_width << ";spatial_splits=" << (spatial_splits ? 1 : 0)
+    << ";kernels=" << hex64(kernel_digest);
+  return k.str();
 }
 
 int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
@@ -92,18 +128,29 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.scene_buffers = wavefront.scene_buffer_count();
 
   const auto passes_start = std::chrono::steady_clock::now();
-  for (int s = 0; s < settings.spp; ++s) {
-    wavefront.render_pass(static_cast<std::uint32_t>(s));
-    if (s == 0) r.first_pass_seconds = since(start);
-    if (options.progress) options.progress(s + 1, settings.spp, since(start));
+  for (int i = 0; i < settings.spp; ++i) {
+    // The absolute sample index: the random numbers of sample s are the same in every part.
+    wavefront.render_pass(static_cast<std::uint32_t>(settings.sample_begin + i));
+    if (i == 0) r.first_pass_seconds = since(start);
+    if (options.progress) options.progress(i + 1, settings.spp, since(start));
   }
   r.render_seconds = since(passes_start);
   r.nonfinite_samples = wavefront.nonfinite_samples();
   r.rays = wavefront.rays_traced();
   r.stages = wavefront.stage_times();
-  FilmImages film = wavefront.image(static_cast<std::uint32_t>(settings.spp));
-  out.image = {settings.width, settings.height, std::move(film.mean)};
-  out.variance = {settings.width, settings.height, std::move(film.variance)};
+  FilmInfo info;
+  info.width = settings.width;
+  info.height = settings.height;
+  info.sample_begin = static_cast<std::uint32_t>(settings.sample_begin);
+  info.sample_end = static_cast<std::uint32_t>(settings.sample_begin + settings.spp);
+  info.key = render_key(scene, settings, bvh_options.width, bvh_options.spatial_splits,
+                        wavefront.source_digest());
+  info.device = r.device;
+  info.nonfinite_samples = r.nonfinite_samples;
+  out.film = wavefront.film(std::move(info));
+  FilmImages images = out.film.images();
+  out.image = {settings.width, settings.height, std::move(images.mean)};
+  out.variance = {settings.width, settings.height, std::move(images.variance)};
   return out;
 }
 

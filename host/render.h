@@ -48,12 +48,23 @@ struct RenderOptions {
 struct Rendered {
   ImageRgb image;     // the estimate of every pixel
   ImageRgb variance;  // the variance of each pixel's estimate (sample variance / spp)
+  Film film;          // the sums both come from, with the render key and the sample range
   RenderReport report;
 };
 
 // Throws wp::Error on invalid settings or device failures.
 Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
                 const RenderOptions& options = {});
+
+// The render key: one line naming everything that changes the image, so that films merge only
+// with films of the same render (host/film.h). ';'-separated name=value fields: the scene's digest
+// (Scene::digest), the environment map's (FNV-1a 64 of its texels) or none, width, height,
+// max_depth, rr_depth, seed, background, env_intensity, env_rotation, strategy, mis_heuristic,
+// light_select, camera, features, bvh_width, spatial_splits and the kernels' source digest. Not
+// in it, as they do not change the image: the sample range, wave and work-group sizes, the scene
+// buffer limit, the device, caching, outputs and reporting.
+std::string render_key(const Scene& scene, const RenderSettings& settings, int bvh_width,
+                       bool spatial_splits, std::uint64_t kernel_digest);
 
 // Checks the ranges of user-facing settings; throws wp::Error naming the option.
 void validate(const RenderSettings& settings);

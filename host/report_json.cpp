@@ -6,6 +6,8 @@
 namespace wp {
 
 namespace {
+constexpr const char* kUnits = "linear RGB radiance (W/(sr m^2) per channel)";
+
 std::string num(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.6g", v);
@@ -46,6 +48,8 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
                                                   const RenderReport& r) {
   return {{"wavepath:scene", scene},
           {"wavepath:spp", std::to_string(s.spp)},
+          {"wavepath:samples",
+           std::to_string(s.sample_begin) + ":" + std::to_string(s.sample_begin + s.spp)},
           {"wavepath:max_depth", std::to_string(s.max_depth)},
           {"wavepath:rr_depth", std::to_string(s.rr_depth)},
           {"wavepath:seed", std::to_string(s.seed)},
@@ -63,14 +67,24 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
           {"wavepath:device", r.device},
           {"wavepath:features", r.features},
           {"wavepath:nonfinite_samples", std::to_string(r.nonfinite_samples)},
-          {"wavepath:units", "linear RGB radiance (W/(sr m^2) per channel)"}};
+          {"wavepath:units", kUnits}};
+}
+
+std::map<std::string, std::string> film_exr_attributes(const FilmInfo& f) {
+  return {{"wavepath:spp", std::to_string(f.samples())},
+          {"wavepath:samples", std::to_string(f.sample_begin) + ":" + std::to_string(f.sample_end)},
+          {"wavepath:device", f.device},
+          {"wavepath:render_key", f.key},
+          {"wavepath:nonfinite_samples", std::to_string(f.nonfinite_samples)},
+          {"wavepath:units", kUnits}};
 }
 
 std::string report_json(const RenderSettings& s, const RenderReport& r, double load_seconds,
                         double total_seconds, const std::vector<std::string>& outputs) {
   std::ostringstream o;
-  o << "{\"spp\":" << s.spp << ",\"width\":" << s.width << ",\"height\":" << s.height
-    << ",\"seconds\":" << num(r.render_seconds)
+  o << "{\"spp\":" << s.spp << ",\"sample_begin\":" << s.sample_begin
+    << ",\"sample_end\":" << s.sample_begin + s.spp << ",\"width\":" << s.width
+    << ",\"height\":" << s.height << ",\"seconds\":" << num(r.render_seconds)
     << ",\"samples_per_second\":" << num(r.samples_per_second(s))
     << ",\"device\":" << json_string(r.device) << ",\"triangles\":" << r.triangles
     << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)

@@ -13,8 +13,12 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene,
                                                   const RenderSettings& settings,
                                                   const RenderReport& report);
 
-// One JSON object on one line. Keys: spp, width, height, seconds (the sample passes),
-// samples_per_second (pixel samples), device, triangles, kernel_build_seconds,
+// The attributes of an image made from a film alone (`wavepath merge`): spp, samples (A:B),
+// device, render_key, nonfinite_samples, units.
+std::map<std::string, std::string> film_exr_attributes(const FilmInfo& film);
+
+// One JSON object on one line. Keys: spp, sample_begin, sample_end, width, height, seconds (the
+// sample passes), samples_per_second (pixel samples), device, triangles, kernel_build_seconds,
 // bvh_build_seconds, bvh_sah_cost, setup_seconds, first_pass_seconds, load_seconds,
 // total_seconds, nonfinite_samples, rays, features, wave_size, bytes_per_path, scene_bytes,
 // scene_buffers, outputs, and with

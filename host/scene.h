@@ -101,6 +101,10 @@ struct Camera {
 
 struct Scene {
   std::string source;  // file the scene came from
+  // FNV-1a 64 (fnv1a.h) of the bytes the scene was loaded from: the glTF or GLB file, then the
+  // external buffers and images it names, in file order. Part of the render key (render.h): it
+  // tells films of different scenes apart. 0 for scenes not loaded from a file.
+  std::uint64_t digest = 0;
 
   // Vertices (world space). normals are unit; uv0 is TEXCOORD_0 or (0,0); color0 is COLOR_0 as
   // linear RGBA or (1,1,1,1).

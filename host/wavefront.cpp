@@ -6,6 +6,7 @@
 
 #include "host/device_scene.h"
 #include "host/error.h"
+#include "host/fnv1a.h"
 #include "host/gltf_loader.h"
 #include "host/kernel_sources.h"
 
@@ -90,24 +91,27 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     queue_slots_ =
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
     counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
-    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, 2 * pixels * sizeof(dev::float4));
+    const std::size_t film_words = pixels * WP_FILM_WORDS_PER_PIXEL;
+    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
     // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
     // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every
     // host write, sized to that write, so a fill (stored one pattern at a time) or a partial write
     // leaves the entire buffer "uninitialised" to its --uninitialized check. The counters are 20
-    // bytes; the film's host zeros are as large as the copy image() reads back, and made once.
+    // bytes; the film's host zeros are as large as the copy film() reads back, and made once.
     const std::vector<dev::uint> zero_counters(WP_COUNTER_COUNT, 0u);
     rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, zero_counters.size() * sizeof(dev::uint),
                                    zero_counters.data());
-    const std::vector<dev::float4> zero_film(2 * pixels, dev::float4{0, 0, 0, 0});
-    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, zero_film.size() * sizeof(dev::float4),
+    const std::vector<std::uint64_t> zero_film(film_words, 0);
+    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, zero_film.size() * sizeof(std::uint64_t),
                                    zero_film.data());
   } catch (const cl::Error& e) {
     rethrow_cl(e, "allocating device memory on " + rt_.device().name);
   }
 
   const auto build_start = std::chrono::steady_clock::now();
-  program_ = rt_.build(program_source(), options_);
+  const std::string source = program_source();
+  source_digest_ = fnv1a64(source.data(), source.size());
+  program_ = rt_.build(source, options_);
   try {
     for (int i = 0; i < kStageCount; ++i) {
       cl::Kernel& k = kernels_.emplace_back(program_, kStageNames[i]);
@@ -285,26 +289,18 @@ void Wavefront::collect_profile() {
   pending_events_.clear();
 }
 
-FilmImages Wavefront::image(std::uint32_t samples) {
-  const std::size_t pixels = std::size_t(settings_.width) * std::size_t(settings_.height);
-  std::vector<dev::float4> film(2 * pixels);
-  rt_.queue().enqueueReadBuffer(film_, CL_TRUE, 0, film.size() * sizeof(dev::float4), film.data());
-  FilmImages out;
-  out.mean.resize(3 * pixels);
-  out.variance.resize(3 * pixels);
-  const double n = samples;
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const float sum[3] = {film[2 * i].x, film[2 * i].y, film[2 * i].z};
-    const float sq[3] = {film[2 * i + 1].x, film[2 * i + 1].y, film[2 * i + 1].z};
-    for (int c = 0; c < 3; ++c) {
-      const double mean = n > 0 ? sum[c] / n : 0.0;
-      // Unbiased sample variance of one sample, divided by n: the variance of the mean.
-      const double var = n > 1 ? std::max(0.0, (sq[c] - n * mean * mean) / (n - 1)) / n : 0.0;
-      out.mean[3 * i + c] = static_cast<float>(mean);
-      out.variance[3 * i + c] = static_cast<float>(var);
-    }
+Film Wavefront::film(FilmInfo info) {
+  if (info.width != settings_.width || info.height != settings_.height)
+    throw Error("Wavefront::film: the film's size is not the render's");
+  Film film(std::move(info));
+  auto& words = film.words();
+  try {
+    rt_.queue().enqueueReadBuffer(film_, CL_TRUE, 0, words.size() * sizeof(std::uint64_t),
+                                  words.data());
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "reading the film back from " + rt_.device().name);
   }
-  return out;
+  return film;
 }
 
 std::uint64_t Wavefront::nonfinite_samples() {

@@ -14,6 +14,7 @@
 #include "bvh/bvh.h"
 #include "host/cl_runtime.h"
 #include "host/environment.h"
+#include "host/film.h"
 #include "host/light_table.h"
 #include "host/path_state.h"
 #include "host/scene.h"
@@ -30,7 +31,10 @@ enum class MisHeuristic { kPower, kBalance };
 struct RenderSettings {
   int width = 640;
   int height = 480;
-  int spp = 64;        // samples per pixel
+  int spp = 64;  // samples per pixel
+  // The render takes sample indices [sample_begin, sample_begin + spp), within [0, 2^20): a
+  // part of a longer render, whose films merge exactly (host/film.h).
+  int sample_begin = 0;
   int max_depth = 12;  // scattering events per path at most
   // Russian roulette from this many scattering events on (>= max_depth: off); 5 from the study in
   // docs/accuracy.md ("Russian roulette"): less variance per sample than 3, the same work or less
@@ -58,11 +62,6 @@ struct RenderSettings {
 // The most bytes of one scene buffer on `device` with `settings`.
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
 
-struct FilmImages {
-  std::vector<float> mean;
-  std::vector<float> variance;
-};
-
 // Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
 struct StageTimes {
   std::array<double, kStageCount> seconds{};
@@ -78,10 +77,9 @@ class Wavefront {
 
   // Renders sample index `sample` for every pixel and adds it to the film.
   void render_pass(std::uint32_t sample);
-  // The film after `samples` passes: per pixel and channel the mean (the image: linear RGB, row by
-  // row from the top, 3 floats per pixel) and the variance of that mean estimated from the
-  // samples (sample variance / samples).
-  FilmImages image(std::uint32_t samples);
+  // The device film read back: the sums of every pass rendered so far, which `info` describes
+  // (its size must be the settings'; its sample range is the passes', as the caller knows them).
+  Film film(FilmInfo info);
   // NaN or infinite values dropped anywhere (queues.h, count_nonfinite).
   std::uint64_t nonfinite_samples();
   // Closest-hit rays (camera and bounce) traced by render_pass so far: a cost measure that, unlike
@@ -137,6 +135,9 @@ class Wavefront {
   std::size_t wave_size() const { return wave_size_; }
   const StageTimes& stage_times() const { return times_; }
   std::string build_options() const { return options_; }
+  // FNV-1a 64 of the program's source (all stage kernels, includes expanded): part of the render
+  // key (render.h), so films of different kernels do not merge.
+  std::uint64_t source_digest() const { return source_digest_; }
   // Seconds spent building the program and compiling every kernel (see prime_kernels).
   double build_seconds() const { return build_seconds_; }
   // Size of the device program binary (implementation-specific: LLVM bitcode on PoCL, PTX on
@@ -161,6 +162,7 @@ class Wavefront {
   std::size_t binary_bytes_ = 0;
   std::uint64_t rays_traced_ = 0;
   std::string options_;
+  std::uint64_t source_digest_ = 0;
 
   SceneBuffers scene_;
   std::uint64_t scene_bytes_ = 0;

@@ -1,12 +1,40 @@
 /* Stage: film accumulation, once per sample pass and wave, after the last bounce.
  * From: every slot of the wave [0, path_count) (finished paths keep their slot).
- * To:   the film: two float4 per pixel, film[2 pixel] += (radiance, 1) and
- *       film[2 pixel + 1] += (radiance^2, 0), so the host has the mean and the sample variance of
- *       every pixel. A sample that is NaN or infinite is not added; it is counted in
- *       counters[WP_COUNTER_NONFINITE] (the renderer reports the count, the tests require 0). */
+ * To:   the film, in fixed point (layout, scale and ranges in shared/film.h): per pixel and
+ *       channel the 128-bit sums S += a and Q += floor(a^2 / 2^32), a = round(radiance * 2^32)
+ *       saturated to [0, 2^64 - 1] (values from 2^32 on saturate). No sum overflows: a < 2^64
+ *       and a^2 / 2^32 < 2^96, so 2^20 samples (the most a film holds) give S < 2^84 and
+ *       Q < 2^116. Integer sums do not depend on the order of addition, so films of sample
+ *       ranges rendered apart merge bit for bit (host/film.h). A sample that is NaN or infinite
+ *       is not added; it is counted in counters[WP_COUNTER_NONFINITE] (the renderer reports the
+ *       count, the tests require 0) and weighs as 0 in the mean (S / 2^32 / spp).
+ *
+ * Radiance is never negative for a valid scene (emission, lights, the background and the
+ * environment are non-negative, and so are BSDF values, cosines and MIS weights); the negative
+ * values that glTF files with out-of-range factors (which the loader accepts) could give
+ * saturate to 0.
+ *
+ * Each pixel is in one slot of a wave and waves run one after another, so the adds need no
+ * atomics. */
 #include "stage.h"
+#include "shared/film.h"
 
-__kernel void accumulate(WP_STAGE_PARAMS, __global float4* film) {
+/* v += (hi, lo), 128-bit values stored as two words, the low one first. */
+inline void film_add128(__global ulong* v, ulong lo, ulong hi) {
+  const ulong sum = v[0] + lo;
+  v[1] += hi + (sum < lo ? 1ul : 0ul); /* the carry; hi < 2^64 - 1 here, so no overflow */
+  v[0] = sum;
+}
+
+/* Adds one channel's value v to the sums at `px` (the pixel's first word). */
+inline void film_add_value(__global ulong* px, uint channel, float v) {
+  const ulong a = convert_ulong_sat_rte(v * 0x1p32f);
+  const ulong sq_lo = a * a, sq_hi = mul_hi(a, a); /* a^2, 128 bits */
+  film_add128(px + WP_FILM_SUM(channel), a, 0ul);
+  film_add128(px + WP_FILM_SQUARES(channel), (sq_hi << 32) | (sq_lo >> 32), sq_hi >> 32);
+}
+
+__kernel void accumulate(WP_STAGE_PARAMS, __global ulong* film) {
   WP_STAGE_BIND;
   const uint slot = get_global_id(0);
   if (slot >= launch.path_count) return;
@@ -15,7 +43,8 @@ __kernel void accumulate(WP_STAGE_PARAMS, __global float4* film) {
     count_nonfinite(queues);
     return;
   }
-  const uint pixel = paths.info[slot].x;
-  film[2u * pixel] += (float4)(l, 1.0f);
-  film[2u * pixel + 1u] += (float4)(l * l, 0.0f);
+  __global ulong* px = film + (size_t)paths.info[slot].x * WP_FILM_WORDS_PER_PIXEL;
+  film_add_value(px, 0u, l.x);
+  film_add_value(px, 1u, l.y);
+  film_add_value(px, 2u, l.z);
 }

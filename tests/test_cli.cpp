@@ -17,23 +17,15 @@
 #include <gtest/gtest.h>
 
 #include "host/image_io.h"
+#include "tests/cli_run.h"
 #include "tests/test_assets.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using wp::test::CliRun;
+using wp::test::slurp;
 
 class Cli : public ::testing::Test {
  protected:
@@ -48,16 +40,7 @@ class Cli : public ::testing::Test {
 
   // Runs `wavepath args` in the test's folder with extra environment `env`.
   CliRun run(const std::string& args, const std::string& env = "") {
-    const std::string cmd = "cd '" + dir_.string() + "' && " + env + " '" WP_WAVEPATH_BIN "' " +
-                            args + " >out.txt 2>err.txt";
-    CliRun r;
-    const int raw = std::system(cmd.c_str());
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(dir_ / "out.txt");
-    r.err = slurp(dir_ / "err.txt");
-    fs::remove(dir_ / "out.txt");
-    fs::remove(dir_ / "err.txt");
-    return r;
+    return wp::test::run_wavepath(dir_, args, env);
   }
 
   // Asserts a failure with one line on stderr that contains `cause`, and no image left behind.
