@@ -57,24 +57,6 @@ std::string key_difference(const std::string& a, const std::string& b) {
   }
 }
 
-// The devices of two films, each listed once ("A + B").
-std::string join_devices(const std::string& a, const std::string& b) {
-  std::vector<std::string> names;
-  for (const std::string* list : {&a, &b}) {
-    std::size_t start = 0;
-    while (start <= list->size()) {
-      std::size_t end = list->find(" + ", start);
-      if (end == std::string::npos) end = list->size();
-      const std::string name = list->substr(start, end - start);
-      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
-      start = end + 3;
-    }
-  }
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : " + ") + n;
-  return out.size() > kMaxDevice ? out.substr(0, kMaxDevice - 3) + "..." : out;
-}
-
 void check_info(const FilmInfo& info) {
   if (info.width < 1 || info.width > kFilmMaxSide || info.height < 1 || info.height > kFilmMaxSide)
     throw Error("film size " + std::to_string(info.width) + "x" + std::to_string(info.height) +
@@ -204,6 +186,42 @@ void Film::add(const Film& other) {
   info_.sample_begin = std::min(info_.sample_begin, other.info_.sample_begin);
   info_.sample_end = std::max(info_.sample_end, other.info_.sample_end);
   info_.nonfinite_samples += other.info_.nonfinite_samples;
+}
+
+std::string join_devices(const std::string& a, const std::string& b) {
+  std::vector<std::string> names;
+  for (const std::string* list : {&a, &b}) {
+    std::size_t start = 0;
+    while (start <= list->size()) {
+      std::size_t end = list->find(" + ", start);
+      if (end == std::string::npos) end = list->size();
+      const std::string name = list->substr(start, end - start);
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+      start = end + 3;
+    }
+  }
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : " + ") + n;
+  return out.size() > kMaxDevice ? out.substr(0, kMaxDevice - 3) + "..." : out;
+}
+
+double relative_error(const FilmImages& images) {
+  const std::size_t values = images.mean.size();
+  if (values == 0) return 0.0;
+  double total = 0.0;
+  for (const float m : images.mean) total += m;
+  const double eps = 0.01 * total / double(values);
+  if (!(eps > 0.0)) return 0.0;  // a black image: no relative error to speak of
+  double sum = 0.0;
+  for (std::size_t i = 0; i + 2 < values; i += 3) {
+    double var = 0.0, sq = 3.0 * eps * eps;
+    for (std::size_t c = i; c < i + 3; ++c) {
+      var += images.variance[c];
+      sq += double(images.mean[c]) * images.mean[c];
+    }
+    sum += var / sq;
+  }
+  return std::sqrt(sum / double(values / 3));
 }
 
 FilmImages Film::images() const {

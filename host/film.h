@@ -77,6 +77,17 @@ class Film {
   std::vector<std::uint64_t> words_;
 };
 
+// The estimated relative error of an image: the root of the mean over pixels of
+//   (var_R + var_G + var_B) / (mean_R^2 + mean_G^2 + mean_B^2 + 3 eps^2),
+// with var the variance of each channel's mean (FilmImages::variance) and eps = 1/100 of the
+// image's mean value over all pixels and channels (so that black pixels do not divide by zero,
+// and the measure does not depend on the image's scale). Its square estimates the relative mean
+// squared error (relMSE) that the image has against the exact one; 0 for a black image.
+double relative_error(const FilmImages& images);
+
+// The devices of two films, each listed once ("A + B"), for a film that holds samples of both.
+std::string join_devices(const std::string& a, const std::string& b);
+
 // Why films `a` and `b` are not of the same render, or "": names the first field of the render
 // key that differs, or the two sizes.
 std::string film_identity_problem(const FilmInfo& a, const FilmInfo& b);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iterator>
+#include <optional>
 #include <random>
 
 #include <ImfChannelList.h>
@@ -195,12 +196,13 @@ std::vector<OutputFile> image_files(const std::vector<std::string>& paths, const
   return files;
 }
 
-void write_files(const std::vector<OutputFile>& files) {
+void write_files(const std::vector<OutputFile>& files, bool signals_remove_and_exit) {
   // Every temporary name is chosen before the first is created, so that an interruption at any
   // point finds all of them registered with the signal handler.
   std::vector<std::string> temps;
   for (const auto& file : files) temps.push_back(temporary_name(file.path));
-  const TempFileGuard guard(temps);
+  std::optional<TempFileGuard> guard;
+  if (signals_remove_and_exit) guard.emplace(temps);
   std::size_t current = 0;  // the file being written, for messages
   try {
     for (; current < files.size(); ++current) files[current].write(temps[current]);

@@ -33,9 +33,11 @@ struct OutputFile {
 
 // Writes `files` atomically as a set: each under a temporary name beside its destination, then,
 // once all are complete, renamed into place (with SIGINT, SIGTERM and SIGHUP blocked). On failure
-// or on one of those signals the temporary files are removed and nothing is replaced. Throws
+// the temporary files are removed and nothing is replaced; so too on one of those signals, after
+// which the process dies of it, unless `signals_remove_and_exit` is false: then the caller's
+// handlers stay in charge (one that only records the signal lets the set complete). Throws
 // wp::Error naming the file.
-void write_files(const std::vector<OutputFile>& files);
+void write_files(const std::vector<OutputFile>& files, bool signals_remove_and_exit = true);
 
 // The image outputs among `paths` (.exr, .png, .pfm; with `variance`, a .pfm's companion
 // .variance.pfm) as OutputFiles for write_files. Throws wp::Error for any other extension.

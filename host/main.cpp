@@ -13,6 +13,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +25,7 @@
 #include "host/gltf_loader.h"
 #include "host/render.h"
 #include "host/report_json.h"
+#include "host/stop_signals.h"
 
 namespace {
 
@@ -46,6 +48,12 @@ struct CliOptions {
   float exposure = 0.0f;
   bool spatial_splits = false;
   std::uint64_t scene_buffer_kib = 0;
+  double time_limit = 0;
+  double noise_threshold = 0;
+  std::string checkpoint;
+  double checkpoint_every = 60;
+  std::string resume;
+  double progress_every = 10;
   bool json = false;
   bool quiet = false;
 };
@@ -142,26 +150,83 @@ void check_options(const CLI::App& render, const CliOptions& cli,
   check(settings.spp <= (1 << 20), "--spp must be at most 1048576");
   check(settings.wave_size <= (std::size_t{1} << 24), "--wave-size must be at most 16777216");
   check(settings.local_size <= 1024, "--local-size must be at most 1024");
+  const auto seconds = [&](double v, const char* name) {
+    check(std::isfinite(v) && v >= 0 && v <= 1e9,
+          std::string(name) + " must be a number of seconds between 0 and 1e9");
+  };
+  seconds(cli.time_limit, "--time-limit");
+  seconds(cli.checkpoint_every, "--checkpoint-every");
+  seconds(cli.progress_every, "--progress-every");
+  check(std::isfinite(cli.noise_threshold) && cli.noise_threshold >= 0,
+        "--noise-threshold must be a relative error >= 0 (e.g. 0.01 for 1%)");
+  check(render.count("--checkpoint-every") == 0 || !cli.checkpoint.empty(),
+        "--checkpoint-every needs --checkpoint FILE");
+  check(cli.checkpoint.empty() || is_film(cli.checkpoint),
+        "--checkpoint " + cli.checkpoint + ": a checkpoint is a .wpfilm file");
   check(render.count("--scene-buffer-kib") == 0 ||
             (cli.scene_buffer_kib >= 1 && cli.scene_buffer_kib <= (std::uint64_t{1} << 25)),
         "--scene-buffer-kib must be between 1 and 33554432 (32 GiB)");
 }
 
+// Progress of the sample passes on stderr: on a terminal a bar redrawn after every pass; else
+// (a log) one line every `every` seconds. Both give the samples done and requested, the time,
+// the ETA (at the pass rate so far; no later than a time limit) and the pixel samples per second.
 class Progress {
  public:
-  explicit Progress(bool enabled) : enabled_(enabled) {}
-  void operator()(int done, int total, double seconds) const {
-    if (!enabled_) return;
-    const double eta = seconds / done * (total - done);
-    std::fprintf(stderr, "\r  %d/%d spp  %5.1f%%  %6.1fs elapsed  ETA %6.1fs ", done, total,
-                 100.0 * done / total, seconds, eta);
-    if (done == total) std::fprintf(stderr, "\n");
+  Progress(bool enabled, bool terminal, double every, double pixels,
+           std::optional<std::chrono::steady_clock::time_point> deadline)
+      : enabled_(enabled),
+        terminal_(terminal),
+        every_(every),
+        pixels_(pixels),
+        deadline_(deadline),
+        next_line_(every) {}
+
+  void update(int done, int total, double seconds, int passes) {
+    if (!enabled_ || (!terminal_ && seconds < next_line_)) return;
+    const double rate = seconds > 0 ? passes / seconds : 0.0;  // passes per second
+    double eta = rate > 0 ? (total - done) / rate : 0.0;
+    if (deadline_)
+      eta = std::min(
+          eta,
+          std::max(0.0, std::chrono::duration<double>(*deadline_ - std::chrono::steady_clock::now())
+                            .count()));
+    const double fraction = double(done) / total;
+    if (terminal_) {
+      char bar[21];
+      const int full = static_cast<int>(fraction * 20);
+      for (int i = 0; i < 20; ++i) bar[i] = i < full ? '#' : '.';
+      bar[20] = 0;
+      std::fprintf(stderr, "\r  [%s] %d/%d spp %5.1f%%  %6.1f s  ETA %6.1f s  %.3g samples/s ", bar,
+                   done, total, 100.0 * fraction, seconds, eta, rate * pixels_);
+      drawn_ = true;
+    } else {
+      std::fprintf(stderr, "wavepath: %d/%d spp (%.1f%%), %.1f s, ETA %.1f s, %.3g samples/s\n",
+                   done, total, 100.0 * fraction, seconds, eta, rate * pixels_);
+      if (every_ > 0)  // 0: a line after every pass
+        while (next_line_ <= seconds) next_line_ += every_;
+    }
     std::fflush(stderr);
+  }
+  // Ends the terminal's bar line, if one was drawn.
+  void finish() {
+    if (drawn_) std::fprintf(stderr, "\n");
+    drawn_ = false;
   }
 
  private:
-  bool enabled_;
+  bool enabled_, terminal_;
+  double every_, pixels_;
+  std::optional<std::chrono::steady_clock::time_point> deadline_;
+  double next_line_;
+  bool drawn_ = false;
 };
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
 
 // Writes every output as one set (image_io.h, write_files): images by extension from `film`'s
 // mean (and variance), .wpfilm files from `film` itself.
@@ -181,11 +246,13 @@ void write_outputs(const CliOptions& cli, const wp::Film& film, const wp::ImageR
   wp::write_files(files);
 }
 
-int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings) {
+int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings,
+                   std::chrono::steady_clock::time_point program_start) {
   if (cli.outputs.empty()) cli.outputs = {"render.exr", "render.png"};
   check_outputs(cli.outputs);
   apply_samples(render, cli, settings);
   check_options(render, cli, settings);
+  if (!cli.checkpoint.empty()) check_outputs({cli.checkpoint});
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
   settings.scene_buffer_bytes = cli.scene_buffer_kib * 1024;
@@ -200,6 +267,11 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   wp::validate(settings);
   if (!cli.env.empty())
     settings.environment = std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env));
+
+  // Read whole before loading the scene (a bad file fails at once) and before rendering (it may
+  // be the --checkpoint file, which the render replaces).
+  std::optional<wp::Film> resume;
+  if (!cli.resume.empty()) resume = wp::Film::read(cli.resume);
 
   const auto start = std::chrono::steady_clock::now();
   const wp::Scene scene = wp::load_gltf(cli.scene);
@@ -216,8 +288,31 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   wp::RenderOptions options;
   options.bvh.spatial_splits = cli.spatial_splits;
   options.bvh_cache = !cli.no_bvh_cache;
-  options.progress = Progress(!cli.quiet && isatty(STDERR_FILENO));
+  if (cli.time_limit > 0)
+    options.deadline = program_start + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                           std::chrono::duration<double>(cli.time_limit));
+  options.noise_threshold = cli.noise_threshold;
+  if (resume) options.resume = &*resume;
+  Progress progress(!cli.quiet, isatty(STDERR_FILENO), cli.progress_every,
+                    double(settings.width) * settings.height, options.deadline);
+  options.progress = [&](int done, int total, double seconds, int passes) {
+    progress.update(done, total, seconds, passes);
+  };
+  if (!cli.checkpoint.empty()) {
+    options.checkpoint_every = cli.checkpoint_every;
+    options.checkpoint = [&](const wp::Film& film) {
+      // Signals are only recorded meanwhile (StopSignals): the checkpoint is always completed.
+      wp::write_files({{cli.checkpoint, [&film](const std::string& t) { film.write(t); }}},
+                      /*signals_remove_and_exit=*/false);
+    };
+  }
+  std::optional<wp::StopSignals> signals(std::in_place);
+  options.passes_starting = [&] { signals->arm(); };
+  options.interrupted = [&] { return signals->received() != 0; };
   const wp::Rendered result = wp::render(runtime, scene, settings, options);
+  progress.finish();
+  const int stop_signal = signals->received();
+  signals.reset();  // from here a signal removes the outputs' temporary files and ends wavepath
 
   auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
   attributes["wavepath:render_key"] = result.film.info().key;
@@ -227,16 +322,26 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   if (result.report.nonfinite_samples > 0)
     std::fprintf(stderr, "wavepath: warning: %llu NaN/Inf samples were left out of the film\n",
                  static_cast<unsigned long long>(result.report.nonfinite_samples));
+  const int done = int(result.report.sample_end) - settings.sample_begin;
   if (cli.json)
     std::cout << wp::report_json(settings, result.report, load_seconds, total, cli.outputs) << "\n";
   else if (!cli.quiet)
     std::fprintf(stderr,
-                 "wavepath: %s: %d spp (samples %d:%d) in %.2f s (%.3g samples/s) on %s; wrote "
-                 "%s\n",
-                 cli.scene.c_str(), settings.spp, settings.sample_begin,
-                 settings.sample_begin + settings.spp, result.report.render_seconds,
+                 "wavepath: %s: %d spp (samples %d:%u, %s) in %.2f s (%.3g samples/s) on %s; "
+                 "wrote %s\n",
+                 cli.scene.c_str(), done, settings.sample_begin, result.report.sample_end,
+                 wp::stop_reason_name(result.report.stop), result.report.render_seconds,
                  result.report.samples_per_second(settings), result.report.device.c_str(),
-                 cli.outputs.front().c_str());
+                 join(cli.outputs).c_str());
+  if (stop_signal) {  // said even with --quiet: the exit status alone would not say what is kept
+    std::fprintf(stderr, "wavepath: interrupted by %s after %d of %d samples; wrote %s%s\n",
+                 wp::signal_name(stop_signal), done, settings.spp, join(cli.outputs).c_str(),
+                 cli.checkpoint.empty() ? ""
+                                        : ("; the checkpoint " + cli.checkpoint +
+                                           " continues with --resume " + cli.checkpoint)
+                                              .c_str());
+    return 128 + stop_signal;
+  }
   return 0;
 }
 
@@ -300,6 +405,7 @@ int merge_command(CliOptions& cli) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const auto program_start = std::chrono::steady_clock::now();  // --time-limit counts from here
   CLI::App app{"wavepath: an OpenCL wavefront path tracer for glTF 2.0 scenes", "wavepath"};
   app.require_subcommand(1);
   // Parse errors in one line, like every other error.
@@ -328,6 +434,33 @@ int main(int argc, char** argv) {
                      "Render only sample indices A to B-1 (0 <= A < B <= 1048576), a part of a "
                      "longer render: its .wpfilm output merges exactly with the other parts' "
                      "(wavepath merge); the image is the mean of these samples [default: 0:spp]");
+  render->add_option("--time-limit", cli.time_limit,
+                     "Stop starting sample passes once SECONDS have passed since wavepath started "
+                     "(loading and building count): a pass is only started if, at the mean pass "
+                     "time so far, it ends in time; at least one pass is rendered. The image "
+                     "holds the samples done (JSON and EXR header: spp, stop) [default: none]");
+  render->add_option("--noise-threshold", cli.noise_threshold,
+                     "Stop once the image's estimated relative error (root mean over pixels of "
+                     "variance / value^2, see README) is at most REL, e.g. 0.01; checked from 16 "
+                     "samples on [default: none]");
+  render->add_option("--checkpoint", cli.checkpoint,
+                     "Keep the film so far in FILE (.wpfilm), written atomically every "
+                     "--checkpoint-every seconds, when the passes end, and on SIGINT/SIGTERM/"
+                     "SIGHUP (which stop the render after the current pass, write every output "
+                     "with the samples so far and exit with 128 + the signal number)");
+  render
+      ->add_option("--checkpoint-every", cli.checkpoint_every,
+                   "Seconds between checkpoints (0: after every pass)")
+      ->capture_default_str();
+  render->add_option("--resume", cli.resume,
+                     "Continue the film in FILE (a checkpoint of the same scene and settings, "
+                     "from the same first sample) up to the requested samples: the result is "
+                     "bit-identical to one uninterrupted render");
+  render
+      ->add_option("--progress-every", cli.progress_every,
+                   "When stderr is not a terminal (a log), a progress line every SECONDS (0: "
+                   "after every pass); on a terminal a bar is redrawn after every pass")
+      ->capture_default_str();
   render->add_option("--camera", settings.camera,
                      "Camera index in node order [default: the first, else one framing the scene]");
   render
@@ -440,7 +573,7 @@ int main(int argc, char** argv) {
         throw wp::Error("--exposure must be a finite number of stops between -64 and 64");
       return merge_command(cli);
     }
-    return render_command(*render, cli, settings);
+    return render_command(*render, cli, settings, program_start);
   } catch (const wp::Error& e) {
     std::cerr << "wavepath: error: " << e.what() << "\n";
     if (!e.details().empty()) std::cerr << e.details() << "\n";

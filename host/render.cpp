@@ -1,5 +1,6 @@
 #include "host/render.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -86,6 +87,20 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
   return k.str();
 }
 
+const char* stop_reason_name(StopReason reason) {
+  switch (reason) {
+    case StopReason::kComplete:
+      return "complete";
+    case StopReason::kTimeLimit:
+      return "time_limit";
+    case StopReason::kNoiseThreshold:
+      return "noise_threshold";
+    case StopReason::kInterrupted:
+      return "interrupted";
+  }
+  return "unknown";
+}
+
 int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.bvh_width) return settings.bvh_width;
   return device.gpu ? 2 : 8;
@@ -127,28 +142,91 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.scene_bytes = wavefront.scene_bytes();
   r.scene_buffers = wavefront.scene_buffer_count();
 
-  const auto passes_start = std::chrono::steady_clock::now();
-  for (int i = 0; i < settings.spp; ++i) {
-    // The absolute sample index: the random numbers of sample s are the same in every part.
-    wavefront.render_pass(static_cast<std::uint32_t>(settings.sample_begin + i));
-    if (i == 0) r.first_pass_seconds = since(start);
-    if (options.progress) options.progress(i + 1, settings.spp, since(start));
-  }
-  r.render_seconds = since(passes_start);
-  r.nonfinite_samples = wavefront.nonfinite_samples();
-  r.rays = wavefront.rays_traced();
-  r.stages = wavefront.stage_times();
+  const std::uint32_t begin = static_cast<std::uint32_t>(settings.sample_begin);
+  const std::uint32_t end = begin + static_cast<std::uint32_t>(settings.spp);
   FilmInfo info;
   info.width = settings.width;
   info.height = settings.height;
-  info.sample_begin = static_cast<std::uint32_t>(settings.sample_begin);
-  info.sample_end = static_cast<std::uint32_t>(settings.sample_begin + settings.spp);
+  info.sample_begin = begin;
   info.key = render_key(scene, settings, bvh_options.width, bvh_options.spatial_splits,
                         wavefront.source_digest());
   info.device = r.device;
-  info.nonfinite_samples = r.nonfinite_samples;
-  out.film = wavefront.film(std::move(info));
+  std::uint32_t next = begin;  // the next sample index to render
+  std::uint64_t resumed_nonfinite = 0;
+  if (options.resume) {
+    const FilmInfo& from = options.resume->info();
+    FilmInfo want = info;
+    want.sample_end = from.sample_end;
+    const std::string problem = film_identity_problem(from, want);
+    if (!problem.empty()) throw Error("the film to resume is of another render: " + problem);
+    if (from.sample_begin != begin || from.sample_end > end)
+      throw Error("the film to resume holds samples " + std::to_string(from.sample_begin) + ":" +
+                  std::to_string(from.sample_end) + ", not the start of the requested " +
+                  std::to_string(begin) + ":" + std::to_string(end));
+    wavefront.load_film(*options.resume);
+    next = from.sample_end;
+    resumed_nonfinite = from.nonfinite_samples;
+    info.device = join_devices(from.device, r.device);
+  }
+  // The film of samples [begin, next), read back from the device.
+  const auto film_so_far = [&] {
+    FilmInfo i = info;
+    i.sample_end = next;
+    i.nonfinite_samples = resumed_nonfinite + wavefront.nonfinite_samples();
+    return wavefront.film(std::move(i));
+  };
+
+  if (options.passes_starting) options.passes_starting();
+  const auto passes_start = std::chrono::steady_clock::now();
+  auto last_checkpoint = passes_start;
+  // The sample count at which the noise threshold is checked next.
+  std::uint32_t next_check = begin + kNoiseMinSamples;
+  while (next < end) {
+    if (options.deadline && r.passes > 0) {
+      const auto mean_pass = (std::chrono::steady_clock::now() - passes_start) / r.passes;
+      if (std::chrono::steady_clock::now() + mean_pass > *options.deadline) {
+        r.stop = StopReason::kTimeLimit;
+        break;
+      }
+    }
+    // The absolute sample index: the random numbers of sample s are the same in every part.
+    wavefront.render_pass(next++);
+    if (r.passes++ == 0) r.first_pass_seconds = since(start);
+    if (options.progress)
+      options.progress(int(next - begin), settings.spp, since(passes_start), r.passes);
+    if (options.interrupted && options.interrupted()) {
+      r.stop = StopReason::kInterrupted;
+      break;
+    }
+    if (options.noise_threshold > 0 && next < end && next >= next_check) {
+      const double e = relative_error(film_so_far().images());
+      if (e <= options.noise_threshold) {
+        r.stop = StopReason::kNoiseThreshold;
+        break;
+      }
+      const double n = next - begin;
+      const double predicted =
+          std::ceil(n * (e / options.noise_threshold) * (e / options.noise_threshold));
+      next_check = begin + static_cast<std::uint32_t>(std::clamp(predicted, n + 1, 2 * n));
+    }
+    if (options.checkpoint && next < end && since(last_checkpoint) >= options.checkpoint_every) {
+      options.checkpoint(film_so_far());
+      ++r.checkpoints;
+      last_checkpoint = std::chrono::steady_clock::now();
+    }
+  }
+  r.render_seconds = since(passes_start);
+  r.nonfinite_samples = resumed_nonfinite + wavefront.nonfinite_samples();
+  r.rays = wavefront.rays_traced();
+  r.stages = wavefront.stage_times();
+  out.film = film_so_far();
+  r.sample_end = next;
+  if (options.checkpoint) {
+    options.checkpoint(out.film);
+    ++r.checkpoints;
+  }
   FilmImages images = out.film.images();
+  r.relative_error = relative_error(images);
   out.image = {settings.width, settings.height, std::move(images.mean)};
   out.variance = {settings.width, settings.height, std::move(images.variance)};
   return out;

@@ -2,8 +2,10 @@
 // sample passes with progress, read-back.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "bvh/bvh.h"
@@ -13,6 +15,20 @@
 #include "host/wavefront.h"
 
 namespace wp {
+
+// Why the sample passes ended.
+enum class StopReason {
+  kComplete,        // every requested sample was rendered
+  kTimeLimit,       // RenderOptions::deadline
+  kNoiseThreshold,  // RenderOptions::noise_threshold
+  kInterrupted,     // RenderOptions::interrupted
+};
+// "complete", "time_limit", "noise_threshold", "interrupted" (JSON and EXR header values).
+const char* stop_reason_name(StopReason reason);
+
+// The fewest samples (in the film, resumed ones included) from which the noise threshold is
+// checked: below, a pixel's variance estimate is too often 0 (no sample found the light yet).
+constexpr int kNoiseMinSamples = 16;
 
 struct RenderReport {
   std::string device;
@@ -33,16 +49,47 @@ struct RenderReport {
   std::uint64_t scene_bytes = 0;  // the packed scene on the device
   int scene_buffers = 0;          // the buffers it is split over (device_scene.h)
   StageTimes stages;              // with RenderSettings::profile
+  // The film holds samples [settings.sample_begin, sample_end): all requested, or fewer when the
+  // passes stopped early (`stop`).
+  std::uint32_t sample_end = 0;
+  int passes = 0;  // sample passes rendered by this call (resumed ones not)
+  StopReason stop = StopReason::kComplete;
+  double relative_error = 0;  // the film's estimated relative error at the end (film.h)
+  int checkpoints = 0;        // RenderOptions::checkpoint calls
   double samples_per_second(const RenderSettings& s) const {
-    return render_seconds > 0 ? double(s.width) * s.height * s.spp / render_seconds : 0.0;
+    return render_seconds > 0 ? double(s.width) * s.height * passes / render_seconds : 0.0;
   }
 };
 
 struct RenderOptions {
   bvh::BuildOptions bvh;   // the width is set per device (bvh_width)
   bool bvh_cache = false;  // look the BVH up in, and store it to, bvh::cache_dir()
-  // Called after each sample pass with (passes done, passes in all, seconds since the start).
-  std::function<void(int, int, double)> progress;
+  // Called after each sample pass with (samples in the film, samples requested, seconds since
+  // the start of the passes, passes rendered by this call).
+  std::function<void(int, int, double, int)> progress;
+
+  // Continue this film (a checkpoint) instead of starting from zero: the same render key and
+  // size, and samples [sample_begin, k) with k <= sample_begin + spp of the settings. Its samples
+  // are not rendered again, and the result is the film of one uninterrupted render, bit for bit.
+  const Film* resume = nullptr;
+  // Called once, just before the first sample pass (after the BVH and the kernels are built).
+  std::function<void()> passes_starting;
+  // Polled after every pass: true ends the passes (StopReason::kInterrupted).
+  std::function<bool()> interrupted;
+  // No pass is started that would end, at the mean pass time so far, after `deadline`; the first
+  // pass of a call is always rendered (StopReason::kTimeLimit).
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+  // > 0: end the passes once the film's estimated relative error (film.h, relative_error) is at
+  // most this (StopReason::kNoiseThreshold). Checked from kNoiseMinSamples samples on, at sample
+  // counts predicted from the last estimate e at n samples as n (e / threshold)^2 (the error
+  // falls as 1/sqrt(n)), at least n + 1 and at most 2n: O(log) read-backs of the film, and the
+  // samples at which it stops depend on the film alone, so the same render stops at the same
+  // count on every device.
+  double noise_threshold = 0;
+  // Called with the film so far every `checkpoint_every` seconds (at a pass boundary) and once
+  // after the last pass.
+  std::function<void(const Film&)> checkpoint;
+  double checkpoint_every = 0;
 };
 
 struct Rendered {

@@ -47,9 +47,11 @@ std::string json_string(const std::string& s) {
 std::map<std::string, std::string> exr_attributes(const std::string& scene, const RenderSettings& s,
                                                   const RenderReport& r) {
   return {{"wavepath:scene", scene},
-          {"wavepath:spp", std::to_string(s.spp)},
-          {"wavepath:samples",
-           std::to_string(s.sample_begin) + ":" + std::to_string(s.sample_begin + s.spp)},
+          {"wavepath:spp", std::to_string(r.sample_end - s.sample_begin)},
+          {"wavepath:spp_requested", std::to_string(s.spp)},
+          {"wavepath:stop", stop_reason_name(r.stop)},
+          {"wavepath:relative_error", num(r.relative_error)},
+          {"wavepath:samples", std::to_string(s.sample_begin) + ":" + std::to_string(r.sample_end)},
           {"wavepath:max_depth", std::to_string(s.max_depth)},
           {"wavepath:rr_depth", std::to_string(s.rr_depth)},
           {"wavepath:seed", std::to_string(s.seed)},
@@ -82,9 +84,12 @@ std::map<std::string, std::string> film_exr_attributes(const FilmInfo& f) {
 std::string report_json(const RenderSettings& s, const RenderReport& r, double load_seconds,
                         double total_seconds, const std::vector<std::string>& outputs) {
   std::ostringstream o;
-  o << "{\"spp\":" << s.spp << ",\"sample_begin\":" << s.sample_begin
-    << ",\"sample_end\":" << s.sample_begin + s.spp << ",\"width\":" << s.width
-    << ",\"height\":" << s.height << ",\"seconds\":" << num(r.render_seconds)
+  o << "{\"spp\":" << r.sample_end - s.sample_begin << ",\"sample_begin\":" << s.sample_begin
+    << ",\"sample_end\":" << r.sample_end << ",\"spp_requested\":" << s.spp
+    << ",\"stop\":" << json_string(stop_reason_name(r.stop)) << ",\"passes\":" << r.passes
+    << ",\"relative_error\":" << num(r.relative_error) << ",\"checkpoints\":" << r.checkpoints
+    << ",\"width\":" << s.width << ",\"height\":" << s.height
+    << ",\"seconds\":" << num(r.render_seconds)
     << ",\"samples_per_second\":" << num(r.samples_per_second(s))
     << ",\"device\":" << json_string(r.device) << ",\"triangles\":" << r.triangles
     << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)

@@ -17,7 +17,9 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene,
 // device, render_key, nonfinite_samples, units.
 std::map<std::string, std::string> film_exr_attributes(const FilmInfo& film);
 
-// One JSON object on one line. Keys: spp, sample_begin, sample_end, width, height, seconds (the
+// One JSON object on one line. Keys: spp (the samples in the image), sample_begin, sample_end,
+// spp_requested, stop (stop_reason_name), passes (rendered by this run; not resumed ones),
+// relative_error (film.h), checkpoints, width, height, seconds (the
 // sample passes), samples_per_second (pixel samples), device, triangles, kernel_build_seconds,
 // bvh_build_seconds, bvh_sah_cost, setup_seconds, first_pass_seconds, load_seconds,
 // total_seconds, nonfinite_samples, rays, features, wave_size, bytes_per_path, scene_bytes,

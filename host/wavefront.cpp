@@ -303,6 +303,17 @@ Film Wavefront::film(FilmInfo info) {
   return film;
 }
 
+void Wavefront::load_film(const Film& film) {
+  if (film.info().width != settings_.width || film.info().height != settings_.height)
+    throw Error("Wavefront::load_film: the film's size is not the render's");
+  try {  // the whole buffer in one write, as in the constructor (Oclgrind's initialisation state)
+    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, film.words().size() * sizeof(std::uint64_t),
+                                   film.words().data());
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "writing the film to " + rt_.device().name);
+  }
+}
+
 std::uint64_t Wavefront::nonfinite_samples() {
   return read_counter(WP_COUNTER_NONFINITE);
 }

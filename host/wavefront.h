@@ -80,6 +80,9 @@ class Wavefront {
   // The device film read back: the sums of every pass rendered so far, which `info` describes
   // (its size must be the settings'; its sample range is the passes', as the caller knows them).
   Film film(FilmInfo info);
+  // Replaces the device film's sums with `film`'s (a checkpoint to continue); its size must be the
+  // settings'.
+  void load_film(const Film& film);
   // NaN or infinite values dropped anywhere (queues.h, count_nonfinite).
   std::uint64_t nonfinite_samples();
   // Closest-hit rays (camera and bounce) traced by render_pass so far: a cost measure that, unlike

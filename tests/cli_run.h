@@ -3,12 +3,16 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include <gtest/gtest.h>
 
 namespace wp::test {
 
@@ -38,6 +42,32 @@ inline CliRun run_wavepath(const std::filesystem::path& dir, const std::string& 
   std::filesystem::remove(dir / "out.txt");
   std::filesystem::remove(dir / "err.txt");
   return r;
+}
+
+// A fixture whose every test has a fresh folder of its own, dir_ (named after the process and the
+// test), removed afterwards.
+class FolderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("wavepath_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name() + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  std::filesystem::path dir_;
+};
+
+// The number after "key": in the JSON line `json` (wavepath's --json output), or NaN when absent.
+inline double json_number(const std::string& json, const std::string& key) {
+  const std::string tag = "\"" + key + "\":";
+  const std::size_t at = json.find(tag);
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + tag.size(), nullptr);
 }
 
 }  // namespace wp::test

@@ -27,17 +27,8 @@ namespace {
 using wp::test::CliRun;
 using wp::test::slurp;
 
-class Cli : public ::testing::Test {
+class Cli : public wp::test::FolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("wavepath_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // Runs `wavepath args` in the test's folder with extra environment `env`.
   CliRun run(const std::string& args, const std::string& env = "") {
     return wp::test::run_wavepath(dir_, args, env);
@@ -58,8 +49,6 @@ class Cli : public ::testing::Test {
   }
 
   std::string cornell() const { return wp::test::source_path("scenes/cornell_box.gltf"); }
-
-  fs::path dir_;
 };
 
 TEST_F(Cli, HelpDescribesRenderOptions) {

@@ -203,18 +203,8 @@ TEST(FilmImages, MeanAndVarianceOfTheMean) {
   EXPECT_LT(big.images().variance[0], 1e-3f);
 }
 
-class FilmFile : public ::testing::Test {
+class FilmFile : public wp::test::FolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("wavepath_film_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
   void put(const std::string& name, const std::string& bytes) const {
     std::ofstream(dir_ / name, std::ios::binary) << bytes;
   }
@@ -225,8 +215,6 @@ class FilmFile : public ::testing::Test {
     EXPECT_EQ(e.rfind(path("bad.wpfilm") + ": ", 0), 0u) << "'" << e << "'";
     return e;
   }
-
-  fs::path dir_;
 };
 
 TEST_F(FilmFile, RoundTrip) {
