@@ -2,6 +2,7 @@
 
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <stb_image.h>
@@ -60,6 +61,48 @@ bool same_use(const TextureRef& a, const TextureRef& b) {
   return a.image == b.image && a.wrap_s == b.wrap_s && a.wrap_t == b.wrap_t &&
          a.nearest == b.nearest && a.srgb == b.srgb && a.texcoord == b.texcoord &&
          a.row_u == b.row_u && a.row_v == b.row_v;
+}
+
+// A PNG's chunks, walked before stb_image sees the file: every chunk's length must fit in the
+// bytes that follow it, and the image data must be able to hold the image. stb_image allocates
+// an IDAT chunk's claimed length (doubling its buffer up to it) before reading it, so a 42 KB
+// file whose IDAT claimed 2 GB made it allocate 2 GiB (fuzzing); and it allocates the decoded
+// image from IHDR's size. Deflate expands at most 1,032-fold, so the filtered rows,
+// height x (1 + width x bits per pixel / 8) bytes, cannot exceed 1,032 x the IDAT bytes (plus
+// slack for the filter bytes of interlaced passes). Not a PNG (no signature): nothing to check.
+void check_png_chunks(const unsigned char* bytes, std::size_t size, const std::string& what) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || std::memcmp(bytes, kSignature, 8) != 0) return;
+  const auto u32 = [&](std::size_t at) {
+    return std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
+           std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+  };
+  double row_bits = 0, rows = 0, idat = 0;
+  std::size_t at = 8;
+  while (at < size) {
+    if (size - at < 12) throw Error(what + ": truncated PNG chunk at byte " + std::to_string(at));
+    const std::size_t length = u32(at);
+    if (length > size - at - 12)
+      throw Error(what + ": PNG chunk at byte " + std::to_string(at) + " claims " +
+                  std::to_string(length) + " bytes, more than the file has");
+    const unsigned char* type = bytes + at + 4;
+    if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13) {
+      const unsigned depth = bytes[at + 16], color = bytes[at + 17];
+      const unsigned samples = color == 2 ? 3 : color == 4 ? 2 : color == 6 ? 4 : 1;
+      row_bits = double(u32(at + 8)) * samples * depth;
+      rows = double(u32(at + 12));
+    } else if (std::memcmp(type, "IDAT", 4) == 0) {
+      idat += double(length);
+    } else if (std::memcmp(type, "IEND", 4) == 0) {
+      break;
+    }
+    at += 12 + length;
+  }
+  const double filtered = rows * (1.0 + std::ceil(row_bits / 8.0));
+  if (filtered > 1032.0 * idat + 8.0 * rows + 65536.0)
+    throw Error(what + ": PNG image data of " + std::to_string(std::size_t(idat)) +
+                " bytes cannot hold its " + std::to_string(std::size_t(filtered)) +
+                " bytes of rows");
 }
 
 }  // namespace
@@ -184,7 +227,13 @@ int TextureTable::image(int index) {
   }
   if (size == 0) throw Error(what + ": no image data (file missing or unreadable?)");
   if (size > static_cast<std::size_t>(INT_MAX)) throw Error(what + ": larger than 2 GiB");
+  check_png_chunks(bytes, size, what);
   int width = 0, height = 0, channels = 0;
+  // At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before stb_image allocates them.
+  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels) &&
+      double(width) * double(height) > double(1u << 28))
+    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
+                " pixels, more than the 16384 x 16384 a texture may have");
   unsigned char* pixels =
       stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
   if (!pixels) {

@@ -937,6 +937,18 @@ TEST(GltfLoader, TextureErrorsNameTheElement) {
   expect_error(
       with("[{\"source\":0}]", base0, R"("images":[{"uri":"nowhere.png"}])").write("t6.gltf"),
       "image 0 (nowhere.png): no image data");
+  // PNGs whose chunks claim more than there is, refused before stb_image allocates for them
+  // (fuzzing: an IDAT claiming 1.9 GB in a 42 KB file took 2 GiB). stb_image_write writes the
+  // signature (8 bytes), IHDR (25; width at 16, height at 20), then IDAT (its length at 33).
+  const auto patched_png = [](std::size_t at, std::uint32_t value) {
+    std::vector<unsigned char> png = encode_png(2, 2, kImage0);
+    for (int i = 0; i < 4; ++i) png[at + i] = static_cast<unsigned char>(value >> (24 - 8 * i));
+    return R"("images":[{"uri":"data:image/png;base64,)" + base64(png) + R"("}])";
+  };
+  expect_error(with("[{\"source\":0}]", base0, patched_png(33, 0x6f71d329u)).write("t8.gltf"),
+               "image 0: PNG chunk at byte 33 claims 1869730601 bytes, more than the file has");
+  expect_error(with("[{\"source\":0}]", base0, patched_png(16, 60000)).write("t9.gltf"),
+               "bytes cannot hold its");
   expect_error(with("[{\"source\":0}]", R"({"normalTexture":{"index":0,"extensions":{)"
                                         R"("KHR_texture_transform":{"offset":[1]}}}})")
                    .write("t7.gltf"),

@@ -140,6 +140,15 @@ def triangle_scene(variant):
             {"attributes": {"POSITION": 0, "COLOR_0": 4}, "mode": 0},
             {"attributes": {"POSITION": 5}, "mode": 5},
             {"attributes": {"POSITION": 0, "TEXCOORD_1": 2}, "mode": 6, "material": 0}]}]
+    elif variant == "png_idat_too_long":
+        # An IDAT chunk claiming more bytes than the file has (stb_image allocated the claim).
+        doc, buf = triangle_scene("plain")
+        png = bytearray(png_rgba(2, 2, (9, 8, 7, 255)))
+        png[33:37] = struct.pack(">I", 0x6F71D329)
+        doc["images"] = [{"uri": data_uri("image/png", bytes(png))}]
+        doc["textures"] = [{"source": 0}]
+        doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+        return doc, buf
     elif variant == "png_empty_idat":
         doc, buf = triangle_scene("plain")
         doc["images"] = [{"uri": data_uri("image/png", png_rgba(2, 2, (9, 8, 7, 255), True))}]
@@ -158,7 +167,7 @@ def triangle_scene(variant):
 
 def builtin_gltf(out):
     for variant in ("plain", "textured", "image_in_buffer", "extensions", "modes",
-                    "sparse_bad_type", "png_empty_idat"):
+                    "sparse_bad_type", "png_empty_idat", "png_idat_too_long"):
         doc, buf = triangle_scene(variant)
         with open(os.path.join(out, "builtin_%s.glb" % variant), "wb") as f:
             f.write(glb(doc, buf))
