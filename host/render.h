@@ -33,6 +33,7 @@ struct RenderReport {
   std::uint64_t scene_bytes = 0;  // the packed scene on the device
   int scene_buffers = 0;          // the buffers it is split over (device_scene.h)
   StageTimes stages;              // with RenderSettings::profile
+  int ranks = 1;  // processes whose samples this is (MPI, host/distributed.h); set by the caller
   double samples_per_second(const RenderSettings& s) const {
     return render_seconds > 0 ? double(s.width) * s.height * s.spp / render_seconds : 0.0;
   }
