@@ -51,7 +51,19 @@ Ranks::Slice Ranks::slice(int begin, int count) const {
 
 #ifndef WP_HAVE_MPI
 
-Ranks::Ranks() = default;
+// Started by mpirun all the same: every process would render every sample and write the same
+// outputs, which is never what was meant.
+Ranks::Ranks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+    const char* size = std::getenv(name);
+    if (size != nullptr && std::atoi(size) > 1)
+      throw Error(std::string("started by an MPI launcher (") + name + "=" + size +
+                  "), but this wavepath was built without MPI: each process would render "
+                  "everything (install libopenmpi-dev and build again, or use --samples and "
+                  "wavepath merge)");
+  }
+}
+
 Ranks::~Ranks() = default;
 
 bool Ranks::all(bool ok) const {
@@ -204,7 +216,10 @@ void judge(const std::vector<Description>& all, Reduced& out) {
     if (all[r].kind != Description::kFailed) continue;
     auto same = std::find_if(failures.begin(), failures.end(),
                              [&](const auto& f) { return f.first->error == all[r].error; });
-    if (same == failures.end()) failures.push_back({&all[r], {}}), same = failures.end() - 1;
+    if (same == failures.end()) {
+      failures.push_back({&all[r], {}});
+      same = failures.end() - 1;
+    }
     same->second.push_back(r);
   }
   if (!failures.empty()) {

@@ -7,6 +7,10 @@
 // process was not started by an MPI launcher, there is one rank and nothing here calls MPI.
 // The same result without MPI, under any job scheduler: `render --samples A:B -o part.wpfilm` per
 // job, then `wavepath merge`.
+//
+// Each rank renders its whole slice: a stop decided while rendering (a time limit, a noise
+// threshold) would need the ranks to agree on where each stops, so that the slices still add up
+// to one range without gaps.
 #pragma once
 
 #include <cstdint>

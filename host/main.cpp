@@ -288,7 +288,9 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
     mine.rays = part.result->report.rays;
   }
   wp::Reduced all = ranks.reduce(std::move(mine));
-  if (!ranks.root()) return all.ok ? 0 : 1;
+  // The job's exit status is rank 0's: another rank's non-zero status would make mpirun kill the
+  // job, maybe before rank 0 has printed why it failed.
+  if (!ranks.root()) return 0;
   if (!all.ok) throw wp::Error(all.error, all.details);
 
   wp::Rendered& result = *part.result;
