@@ -109,16 +109,23 @@ std::vector<DeviceEntry> enumerate_devices() {
   return out;
 }
 
-DeviceEntry select_device(const std::string& spec) {
+DeviceEntry select_device(const std::string& spec, int nth) {
   const std::vector<DeviceEntry> all = enumerate_devices();
   if (all.empty())
     throw Error("no OpenCL device found (is an OpenCL driver such as pocl-opencl-icd installed?)");
   if (spec.empty()) {
-    for (const auto& e : all)
-      if (e.gpu) return e;
-    for (const auto& e : all)
-      if (e.type == "CPU") return e;
-    return all.front();
+    // One kind only: a CPU device beside GPUs would take another BVH layout (bvh_width), hence
+    // another render key, and its part could not be merged with theirs.
+    using Kind = bool (*)(const DeviceEntry&);
+    const Kind kinds[] = {[](const DeviceEntry& e) { return e.gpu; },
+                          [](const DeviceEntry& e) { return e.type == "CPU"; }};
+    for (const Kind kind : kinds) {
+      std::vector<const DeviceEntry*> matching;
+      for (const auto& e : all)
+        if (kind(e)) matching.push_back(&e);
+      if (!matching.empty()) return *matching[std::size_t(nth) % matching.size()];
+    }
+    return all[std::size_t(nth) % all.size()];
   }
   if (std::all_of(spec.begin(), spec.end(), [](unsigned char c) { return std::isdigit(c); })) {
     const unsigned long i = std::stoul(spec);

@@ -28,10 +28,12 @@ struct DeviceEntry {
 // implementation at all (no ICD loader entries).
 std::vector<DeviceEntry> enumerate_devices();
 
-// `spec` empty: the first GPU, else the first CPU device, else the first device. Otherwise an
-// index into enumerate_devices() or a case-insensitive substring of "platform device name".
+// `spec` empty: the first GPU, else the first CPU device, else the first device; with `nth`, the
+// nth of those (modulo their number), so that processes sharing a machine (MPI ranks,
+// host/distributed.h) spread over its devices of one kind. Otherwise an index into
+// enumerate_devices() or a case-insensitive substring of "platform device name".
 // Throws wp::Error when nothing matches or there is no device.
-DeviceEntry select_device(const std::string& spec);
+DeviceEntry select_device(const std::string& spec, int nth = 0);
 
 // The name of an OpenCL error code ("CL_OUT_OF_RESOURCES").
 std::string cl_error_name(cl_int code);

@@ -15,10 +15,13 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 
 #include "host/cl_runtime.h"
+#include "host/distributed.h"
 #include "host/environment.h"
 #include "host/error.h"
 #include "host/film.h"
@@ -246,12 +249,21 @@ void write_outputs(const CliOptions& cli, const wp::Film& film, const wp::ImageR
   wp::write_files(files);
 }
 
-int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings,
-                   std::chrono::steady_clock::time_point program_start) {
+// The settings, checked before the scene is loaded: options, sample range, the environment map,
+// and (on rank 0, which writes them) the outputs, so that a render that could not be saved fails
+// before it starts.
+void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings,
+                    const wp::Ranks& ranks) {
   if (cli.outputs.empty()) cli.outputs = {"render.exr", "render.png"};
-  check_outputs(cli.outputs);
+  if (ranks.root()) check_outputs(cli.outputs);
   apply_samples(render, cli, settings);
   check_options(render, cli, settings);
+  if (ranks.size() > 1 && (cli.time_limit > 0 || cli.noise_threshold > 0 ||
+                           !cli.checkpoint.empty() || !cli.resume.empty()))
+    throw wp::Error(
+        "--time-limit, --noise-threshold, --checkpoint and --resume do not work under MPI yet "
+        "(the ranks would have to agree where each stops); render sample ranges (--samples) "
+        "and merge them instead");
   if (!cli.checkpoint.empty()) check_outputs({cli.checkpoint});
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
@@ -267,24 +279,42 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   wp::validate(settings);
   if (!cli.env.empty())
     settings.environment = std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env));
+}
 
+// This process's share of the render: its slice of the samples (all of them without MPI)
+// rendered on its device. None when an MPI job has more ranks than samples.
+struct RenderPart {
+  std::optional<wp::Rendered> result;
+  double load_seconds = 0;
+  int stop_signal = 0;  // the signal that ended the passes early (stop_signals.h), or 0
+};
+
+RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings,
+                       const wp::Ranks& ranks,
+                       std::chrono::steady_clock::time_point program_start) {
+  const auto start = std::chrono::steady_clock::now();
+  RenderPart part;
+  const wp::Ranks::Slice slice = ranks.slice(settings.sample_begin, settings.spp);
+  if (slice.samples == 0) return part;
+  wp::RenderSettings mine = settings;
+  mine.sample_begin = slice.first;
+  mine.spp = slice.samples;
   // Read whole before loading the scene (a bad file fails at once) and before rendering (it may
   // be the --checkpoint file, which the render replaces).
   std::optional<wp::Film> resume;
   if (!cli.resume.empty()) resume = wp::Film::read(cli.resume);
-
-  const auto start = std::chrono::steady_clock::now();
   const wp::Scene scene = wp::load_gltf(cli.scene);
   // Known now, not only once the kernels are built and the BVH is made.
-  if (settings.camera >= 0 && static_cast<std::size_t>(settings.camera) >= scene.cameras.size())
-    throw wp::Error("--camera " + std::to_string(settings.camera) + ": the scene has " +
+  if (mine.camera >= 0 && static_cast<std::size_t>(mine.camera) >= scene.cameras.size())
+    throw wp::Error("--camera " + std::to_string(mine.camera) + ": the scene has " +
                     std::to_string(scene.cameras.size()) + " camera(s)");
-  const double load_seconds =
+  part.load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!cli.quiet)
+  if (!cli.quiet && ranks.root())
     for (const auto& w : scene.warnings) std::fprintf(stderr, "wavepath: warning: %s\n", w.c_str());
 
-  wp::ClRuntime runtime(wp::select_device(cli.device));
+  // Ranks on one machine spread over its devices, unless --device names one.
+  wp::ClRuntime runtime(wp::select_device(cli.device, ranks.local_rank()));
   wp::RenderOptions options;
   options.bvh.spatial_splits = cli.spatial_splits;
   options.bvh_cache = !cli.no_bvh_cache;
@@ -293,7 +323,8 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
                                            std::chrono::duration<double>(cli.time_limit));
   options.noise_threshold = cli.noise_threshold;
   if (resume) options.resume = &*resume;
-  Progress progress(!cli.quiet, isatty(STDERR_FILENO), cli.progress_every,
+  // Rank 0's passes stand for the job's: the ranks render at about the same pace.
+  Progress progress(!cli.quiet && ranks.root(), isatty(STDERR_FILENO), cli.progress_every,
                     double(settings.width) * settings.height, options.deadline);
   options.progress = [&](int done, int total, double seconds, int passes) {
     progress.update(done, total, seconds, passes);
@@ -306,13 +337,81 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
                       /*signals_remove_and_exit=*/false);
     };
   }
-  std::optional<wp::StopSignals> signals(std::in_place);
-  options.passes_starting = [&] { signals->arm(); };
-  options.interrupted = [&] { return signals->received() != 0; };
-  const wp::Rendered result = wp::render(runtime, scene, settings, options);
+  // Alone, a signal while the passes run stops them after the current one (stop_signals.h); in
+  // an MPI job it ends the job, as every rank has to render its whole slice.
+  std::optional<wp::StopSignals> signals;
+  if (ranks.size() == 1) {
+    signals.emplace();
+    options.passes_starting = [&] { signals->arm(); };
+    options.interrupted = [&] { return signals->received() != 0; };
+  }
+  part.result = wp::render(runtime, scene, mine, options);
   progress.finish();
-  const int stop_signal = signals->received();
-  signals.reset();  // from here a signal removes the outputs' temporary files and ends wavepath
+  if (signals) part.stop_signal = signals->received();
+  // From here (signals destroyed) a signal removes the outputs' temporary files and ends wavepath.
+  return part;
+}
+
+// The message main() prints for an exception: one line, then the details (wp::Error's) if any.
+std::pair<std::string, std::string> describe(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const wp::Error& e) {
+    return {e.what(), e.details()};
+  } catch (const cl::Error& e) {
+    return {std::string("OpenCL: ") + e.what() + " failed with " + wp::cl_error_name(e.err()), ""};
+  } catch (const std::exception& e) {
+    return {e.what(), ""};
+  } catch (...) {
+    return {"unknown exception", ""};
+  }
+}
+
+int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings,
+                   std::chrono::steady_clock::time_point program_start) {
+  const auto start = std::chrono::steady_clock::now();
+  // One rank of one, unless started by mpirun (host/distributed.h).
+  const wp::Ranks ranks;
+  // In an MPI job every rank reaches ranks.reduce, whatever fails where, so that none waits for
+  // ever: a failure is kept in `mine` and the steps after it are skipped. Alone, it is thrown.
+  wp::RankPart mine;
+  RenderPart part;
+  const auto attempt = [&](const auto& step) {
+    if (!mine.error.empty()) return;
+    try {
+      step();
+    } catch (...) {
+      if (ranks.size() == 1) throw;
+      std::tie(mine.error, mine.details) = describe(std::current_exception());
+    }
+  };
+  attempt([&] { prepare_render(render, cli, settings, ranks); });
+  // Options and outputs are agreed on before any rank spends time rendering.
+  if (ranks.all(mine.error.empty()))
+    attempt([&] { part = render_part(cli, settings, ranks, program_start); });
+  if (part.result) {
+    mine.film = std::move(part.result->film);
+    mine.render_seconds = part.result->report.render_seconds;
+    mine.rays = part.result->report.rays;
+  }
+  wp::Reduced all = ranks.reduce(std::move(mine));
+  // The job's exit status is rank 0's: another rank's non-zero status would make mpirun kill the
+  // job, maybe before rank 0 has printed why it failed.
+  if (!ranks.root()) return 0;
+  if (!all.ok) throw wp::Error(all.error, all.details);
+
+  wp::Rendered& result = *part.result;
+  result.film = std::move(all.film);
+  if (ranks.size() > 1) {  // the image and report of every rank's samples
+    wp::FilmImages images = result.film.images();
+    result.image = {settings.width, settings.height, std::move(images.mean)};
+    result.variance = {settings.width, settings.height, std::move(images.variance)};
+    result.report.render_seconds = all.render_seconds;
+    result.report.rays = all.rays;
+    result.report.nonfinite_samples = result.film.info().nonfinite_samples;
+    result.report.device = result.film.info().device;
+  }
+  result.report.ranks = ranks.size();
 
   auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
   attributes["wavepath:render_key"] = result.film.info().key;
@@ -324,7 +423,8 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
                  static_cast<unsigned long long>(result.report.nonfinite_samples));
   const int done = int(result.report.sample_end) - settings.sample_begin;
   if (cli.json)
-    std::cout << wp::report_json(settings, result.report, load_seconds, total, cli.outputs) << "\n";
+    std::cout << wp::report_json(settings, result.report, part.load_seconds, total, cli.outputs)
+              << "\n";
   else if (!cli.quiet)
     std::fprintf(stderr,
                  "wavepath: %s: %d spp (samples %d:%u, %s) in %.2f s (%.3g samples/s) on %s; "
@@ -333,7 +433,8 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
                  wp::stop_reason_name(result.report.stop), result.report.render_seconds,
                  result.report.samples_per_second(settings), result.report.device.c_str(),
                  join(cli.outputs).c_str());
-  if (stop_signal) {  // said even with --quiet: the exit status alone would not say what is kept
+  if (const int stop_signal = part.stop_signal) {  // said even with --quiet: the exit status alone
+                                                   // would not say what is kept
     std::fprintf(stderr, "wavepath: interrupted by %s after %d of %d samples; wrote %s%s\n",
                  wp::signal_name(stop_signal), done, settings.spp, join(cli.outputs).c_str(),
                  cli.checkpoint.empty() ? ""
@@ -574,16 +675,10 @@ int main(int argc, char** argv) {
       return merge_command(cli);
     }
     return render_command(*render, cli, settings, program_start);
-  } catch (const wp::Error& e) {
-    std::cerr << "wavepath: error: " << e.what() << "\n";
-    if (!e.details().empty()) std::cerr << e.details() << "\n";
-    return 1;
-  } catch (const cl::Error& e) {
-    std::cerr << "wavepath: error: OpenCL: " << e.what() << " failed with "
-              << wp::cl_error_name(e.err()) << "\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "wavepath: error: " << e.what() << "\n";
+  } catch (...) {
+    const auto [message, details] = describe(std::current_exception());
+    std::cerr << "wavepath: error: " << message << "\n";
+    if (!details.empty()) std::cerr << details << "\n";
     return 1;
   }
 }

@@ -56,6 +56,7 @@ struct RenderReport {
   StopReason stop = StopReason::kComplete;
   double relative_error = 0;  // the film's estimated relative error at the end (film.h)
   int checkpoints = 0;        // RenderOptions::checkpoint calls
+  int ranks = 1;  // processes whose samples this is (MPI, host/distributed.h); set by the caller
   double samples_per_second(const RenderSettings& s) const {
     return render_seconds > 0 ? double(s.width) * s.height * passes / render_seconds : 0.0;
   }

@@ -103,7 +103,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"nonfinite_samples\":" << r.nonfinite_samples << ",\"rays\":" << r.rays
     << ",\"features\":" << json_string(r.features) << ",\"wave_size\":" << r.wave_size
     << ",\"bytes_per_path\":" << r.bytes_per_path << ",\"scene_bytes\":" << r.scene_bytes
-    << ",\"scene_buffers\":" << r.scene_buffers << ",\"outputs\":[";
+    << ",\"scene_buffers\":" << r.scene_buffers << ",\"ranks\":" << r.ranks << ",\"outputs\":[";
   for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);
   o << "]";
   if (s.profile) {

@@ -12,6 +12,7 @@ PACKAGES=(
   libembree-dev libtinygltf-dev libglm-dev libopenexr-dev libstb-dev libcli11-dev
   libgtest-dev libbenchmark-dev oclgrind
   clang libclang-rt-14-dev nlohmann-json3-dev
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()
