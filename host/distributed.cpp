@@ -128,9 +128,10 @@ std::string encode(const RankPart& part) {
   put(out, part.rays);
   if (kind == Description::kFilm) {
     const FilmInfo& i = part.film->info();
-    for (const std::uint64_t v : {std::uint64_t(i.width), std::uint64_t(i.height),
-                                  std::uint64_t(i.sample_begin), std::uint64_t(i.sample_end),
-                                  i.nonfinite_samples, std::uint64_t(part.film->words().size())})
+    for (const std::uint64_t v :
+         {std::uint64_t(i.width), std::uint64_t(i.height), std::uint64_t(i.sample_begin),
+          std::uint64_t(i.sample_end), i.nonfinite_samples,
+          std::uint64_t(part.film->words().size()), std::uint64_t(i.aov)})
       put(out, v);
     put(out, i.key);
     put(out, i.device);
@@ -178,6 +179,7 @@ Description decode(const std::string& text) {
     d.info.sample_end = static_cast<std::uint32_t>(in.number());
     d.info.nonfinite_samples = in.number();
     d.words = in.number();
+    d.info.aov = in.number() != 0;
     d.info.key = in.text();
     d.info.device = in.text();
   }
@@ -238,7 +240,7 @@ void judge(const std::vector<Description>& all, Reduced& out) {
     if (all[r].kind != Description::kFilm) continue;
     const FilmInfo& info = all[r].info;
     if (all[r].words !=
-        std::uint64_t(info.width) * std::uint64_t(info.height) * WP_FILM_WORDS_PER_PIXEL) {
+        std::uint64_t(info.width) * std::uint64_t(info.height) * info.words_per_pixel()) {
       out.error = "rank " + std::to_string(r) + ": its film's size does not match its data";
       return;
     }

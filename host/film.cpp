@@ -33,10 +33,11 @@ namespace wp {
 
 namespace {
 
-constexpr std::uint64_t kBytesPerPixel = WP_FILM_WORDS_PER_PIXEL * sizeof(std::uint64_t);
 constexpr const char* kLayout =
     "per pixel, rows from the top: 6 unsigned 128-bit sums, each two little-endian uint64 (low "
     "first): sum of a = round(v * 2^32) for R, G, B, then sum of floor(a^2 / 2^32) for R, G, B";
+constexpr const char* kAovLayout =
+    "; then 7 more: sum of round(v * 2^32) for albedo R, G, B, normal X + 1, Y + 1, Z + 1, depth";
 constexpr std::size_t kMaxDevice = 1024;  // characters of a merged device list
 
 std::string range(std::uint32_t begin, std::uint32_t end) {
@@ -71,7 +72,9 @@ struct FileCloser {
 };
 using File = std::unique_ptr<std::FILE, FileCloser>;
 
-constexpr std::size_t kChunkWords = WP_FILM_WORDS_PER_PIXEL * 4096;  // whole pixels, 384 KiB
+// Whole pixels with and without AOVs (156 = 12 x 13 = 26 x 6): 2.4 MiB.
+constexpr std::size_t kChunkWords = 156 * 2048;
+static_assert(kChunkWords % WP_FILM_WORDS(0) == 0 && kChunkWords % WP_FILM_WORDS(1) == 0);
 
 // Words [first, first + count) as little-endian bytes.
 void encode(const std::uint64_t* words, std::size_t count, unsigned char* out) {
@@ -110,23 +113,27 @@ std::string header_prefix(const FilmInfo& info, std::uint64_t data_bytes) {
   o << "{\"format\":" << kFilmFormat << ",\"width\":" << info.width << ",\"height\":" << info.height
     << ",\"sample_begin\":" << info.sample_begin << ",\"sample_end\":" << info.sample_end
     << ",\"spp\":" << info.samples() << ",\"fraction_bits\":" << WP_FILM_FRACTION_BITS
-    << ",\"words_per_pixel\":" << WP_FILM_WORDS_PER_PIXEL << ",\"layout\":" << json_string(kLayout)
+    << ",\"words_per_pixel\":" << info.words_per_pixel()
+    << ",\"layout\":" << json_string(std::string(kLayout) + (info.aov ? kAovLayout : ""))
     << ",\"data_bytes\":" << data_bytes << ",\"nonfinite_samples\":" << info.nonfinite_samples
     << ",\"device\":" << json_string(printable(info.device))
     << ",\"key\":" << json_string(printable(info.key));
   return o.str();
 }
 
-// Every sum of the `pixels` pixels at `w` within what n samples can give (S < n 2^64,
-// Q < n 2^96): the bound the no-overflow argument of kernels/shared/film.h rests on. Returns the
-// first pixel that breaks it, or -1.
-long long first_implausible_pixel(const std::uint64_t* w, std::size_t pixels, std::uint64_t n) {
-  for (std::size_t p = 0; p < pixels; ++p)
-    for (unsigned c = 0; c < 3; ++c) {
-      const std::size_t base = p * WP_FILM_WORDS_PER_PIXEL;
-      if (w[base + WP_FILM_SUM(c) + 1] >= n || (w[base + WP_FILM_SQUARES(c) + 1] >> 32) >= n)
+// Every sum of the `pixels` pixels at `w` (`stride` words each) within what n samples can give
+// (S and the AOV sums < n 2^64, Q < n 2^96): the bound the no-overflow argument of
+// kernels/shared/film.h rests on. Returns the first pixel that breaks it, or -1.
+long long first_implausible_pixel(const std::uint64_t* w, std::size_t pixels, std::size_t stride,
+                                  std::uint64_t n) {
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const std::uint64_t* px = w + p * stride;
+    for (unsigned c = 0; c < 3; ++c)
+      if (px[WP_FILM_SUM(c) + 1] >= n || (px[WP_FILM_SQUARES(c) + 1] >> 32) >= n)
         return static_cast<long long>(p);
-    }
+    for (std::size_t word = WP_FILM_WORDS_PER_PIXEL; word < stride; word += 2)
+      if (px[word + 1] >= n) return static_cast<long long>(p);
+  }
   return -1;
 }
 
@@ -145,7 +152,7 @@ Uint128 film_square(std::uint64_t a) {
 
 Film::Film(FilmInfo info) : info_(std::move(info)) {
   check_info(info_);
-  words_.assign(pixels() * WP_FILM_WORDS_PER_PIXEL, 0);
+  words_.assign(pixels() * info_.words_per_pixel(), 0);
 }
 
 std::string film_identity_problem(const FilmInfo& a, const FilmInfo& b) {
@@ -153,6 +160,7 @@ std::string film_identity_problem(const FilmInfo& a, const FilmInfo& b) {
     return "different sizes (" + std::to_string(a.width) + "x" + std::to_string(a.height) +
            " and " + std::to_string(b.width) + "x" + std::to_string(b.height) + ")";
   if (a.key != b.key) return "different renders (" + key_difference(a.key, b.key) + ")";
+  if (a.aov != b.aov) return "one film has AOVs, the other not";
   return "";
 }
 
@@ -241,6 +249,20 @@ FilmImages Film::images() const {
       out.mean[3 * i + c] = static_cast<float>(mean);
       out.variance[3 * i + c] = static_cast<float>(var);
     }
+  if (!info_.aov) return out;
+  out.albedo.resize(3 * pixels());
+  out.normal.resize(3 * pixels());
+  out.depth.resize(pixels());
+  const auto mean_of = [&](std::size_t pixel, unsigned word) {
+    return n > 0 ? static_cast<long double>(at(pixel, word)) * 0x1p-32L / n : 0.0L;
+  };
+  for (std::size_t i = 0; i < pixels(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      out.albedo[3 * i + c] = static_cast<float>(mean_of(i, WP_FILM_ALBEDO(c)));
+      out.normal[3 * i + c] = static_cast<float>(mean_of(i, WP_FILM_NORMAL(c)) - 1.0L);
+    }
+    out.depth[i] = static_cast<float>(mean_of(i, WP_FILM_DEPTH));
+  }
   return out;
 }
 
@@ -307,7 +329,7 @@ OpenedFilm open_film(const std::string& path) {
   o.header_hash = fnv1a64(line.data(), line.size() - std::strlen(kChecksumField) - 16 - 2);
   const FilmInfo& info = o.header.info;
   const std::uint64_t data_bytes =
-      std::uint64_t(info.width) * std::uint64_t(info.height) * kBytesPerPixel;
+      std::uint64_t(info.width) * std::uint64_t(info.height) * info.words_per_pixel() * 8u;
   if (o.header.data_bytes != data_bytes)
     throw fail("header's data_bytes " + std::to_string(o.header.data_bytes) + " is not " +
                std::to_string(data_bytes) + " for its size");
@@ -326,7 +348,8 @@ OpenedFilm open_film(const std::string& path) {
 void read_data(OpenedFilm& o, const std::string& path, std::uint64_t* words) {
   const auto fail = [&](const std::string& what) { return Error(path + ": " + what); };
   const FilmInfo& info = o.header.info;
-  const std::size_t total = std::size_t(info.width) * info.height * WP_FILM_WORDS_PER_PIXEL;
+  const std::size_t stride = info.words_per_pixel();
+  const std::size_t total = std::size_t(info.width) * info.height * stride;
   std::vector<unsigned char> bytes(8 * kChunkWords);
   std::vector<std::uint64_t> scratch(words ? 0 : kChunkWords);
   std::uint64_t h = o.header_hash;
@@ -338,10 +361,8 @@ void read_data(OpenedFilm& o, const std::string& path, std::uint64_t* words) {
     h = fnv1a64(bytes.data(), 8 * n, h);
     std::uint64_t* w = words ? words + i : scratch.data();
     decode(bytes.data(), n, w);
-    const long long chunk_bad =
-        first_implausible_pixel(w, n / WP_FILM_WORDS_PER_PIXEL, info.samples());
-    if (bad < 0 && chunk_bad >= 0)
-      bad = static_cast<long long>(i / WP_FILM_WORDS_PER_PIXEL) + chunk_bad;
+    const long long chunk_bad = first_implausible_pixel(w, n / stride, stride, info.samples());
+    if (bad < 0 && chunk_bad >= 0) bad = static_cast<long long>(i / stride) + chunk_bad;
   }
   if (h != o.header.checksum)
     throw fail("corrupted: the checksum of its header and data is " + hex64(h) +

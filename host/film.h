@@ -19,16 +19,22 @@ __extension__ typedef unsigned __int128 Uint128;
 struct FilmImages {
   std::vector<float> mean;
   std::vector<float> variance;
+  // With AOVs (FilmInfo::aov), else empty: per pixel the mean over its samples of the albedo
+  // (3 floats, linear RGB), the shading normal (3, world space, facing the camera's side, not
+  // renormalised: the mean of unit vectors) and the depth (1, metres from the camera).
+  std::vector<float> albedo, normal, depth;
 };
 
 struct FilmInfo {
   int width = 0, height = 0;  // 1..kFilmMaxSide each
+  bool aov = false;           // holds AOV sums too (WP_FILM_WORDS(aov) words per pixel)
   // The samples the sums hold: indices [sample_begin, sample_end), within [0, 2^20).
   std::uint32_t sample_begin = 0, sample_end = 0;
   std::string key;     // the render key (render.h, render_key): films merge only with equal keys
   std::string device;  // where the samples were rendered; "A + B" once films of two merge
   std::uint64_t nonfinite_samples = 0;  // NaN/Inf values dropped while rendering them
   std::uint32_t samples() const { return sample_end - sample_begin; }
+  std::size_t words_per_pixel() const { return WP_FILM_WORDS(aov); }
 };
 
 constexpr int kFilmMaxSide = 16384;
@@ -41,7 +47,7 @@ class Film {
 
   const FilmInfo& info() const { return info_; }
   std::size_t pixels() const { return std::size_t(info_.width) * std::size_t(info_.height); }
-  // WP_FILM_WORDS_PER_PIXEL words per pixel in the layout of kernels/shared/film.h.
+  // info().words_per_pixel() words per pixel in the layout of kernels/shared/film.h.
   std::vector<std::uint64_t>& words() { return words_; }
   const std::vector<std::uint64_t>& words() const { return words_; }
   // S (the sum of a) and Q (the sum of floor(a^2 / 2^32)) of one pixel's channel.
@@ -69,7 +75,7 @@ class Film {
 
  private:
   Uint128 at(std::size_t pixel, unsigned word) const {
-    const std::size_t i = pixel * WP_FILM_WORDS_PER_PIXEL + word;
+    const std::size_t i = pixel * info_.words_per_pixel() + word;
     return Uint128(words_[i + 1]) << 64 | words_[i];
   }
 

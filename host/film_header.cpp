@@ -185,8 +185,12 @@ FilmHeader parse_film_header(const std::string& line) {
     throw Error("film format " + std::to_string(format) +
                 " is not supported (this wavepath reads " + std::to_string(kFilmFormat) + ")");
   f.in("fraction_bits", WP_FILM_FRACTION_BITS, WP_FILM_FRACTION_BITS);
-  f.in("words_per_pixel", WP_FILM_WORDS_PER_PIXEL, WP_FILM_WORDS_PER_PIXEL);
+  const std::uint64_t words = f.in("words_per_pixel", WP_FILM_WORDS(0), WP_FILM_WORDS(1));
+  if (words != WP_FILM_WORDS(0) && words != WP_FILM_WORDS(1))
+    throw Error("header field \"words_per_pixel\" is " + std::to_string(words) + ", not " +
+                std::to_string(WP_FILM_WORDS(0)) + " or " + std::to_string(WP_FILM_WORDS(1)));
   FilmHeader h;
+  h.info.aov = words == WP_FILM_WORDS(1);
   h.info.width = static_cast<int>(f.in("width", 1, kFilmMaxSide));
   h.info.height = static_cast<int>(f.in("height", 1, kFilmMaxSide));
   h.info.sample_begin =

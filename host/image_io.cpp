@@ -47,12 +47,22 @@ void add_rgb(Imf::Header& header, Imf::FrameBuffer& fb, const ImageRgb& img,
 }
 
 void write_exr(const std::string& path, const ImageRgb& img,
-               const std::map<std::string, std::string>& attributes, const ImageRgb* variance) {
+               const std::map<std::string, std::string>& attributes,
+               const std::vector<ImageLayer>& layers) {
   Imf::Header header(img.width, img.height);
   for (const auto& [key, value] : attributes) header.insert(key, Imf::StringAttribute(value));
   Imf::FrameBuffer fb;
   add_rgb(header, fb, img, "");
-  if (variance) add_rgb(header, fb, *variance, "variance.");
+  for (const ImageLayer& layer : layers) {
+    const std::size_t n = layer.channels.size(), xs = n * sizeof(float),
+                      ys = xs * static_cast<std::size_t>(img.width);
+    char* base = reinterpret_cast<char*>(const_cast<float*>(layer.data.data()));
+    for (std::size_t c = 0; c < n; ++c) {
+      const std::string name = layer.name + "." + layer.channels[c];
+      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+      fb.insert(name, Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+    }
+  }
   Imf::OutputFile file(path.c_str(), header);
   file.setFrameBuffer(fb);
   file.writePixels(img.height);
@@ -74,20 +84,23 @@ void write_png(const std::string& path, const ImageRgb& img, const PngOptions& p
 }
 
 // Portable FloatMap: "PF", size, -1 (little-endian), then float RGB rows from the bottom up.
-void write_pfm(const std::string& path, const ImageRgb& img) {
+// A PFM of `channels` (3: colour "PF", 1: greyscale "Pf") floats per pixel, rows from the top
+// in `data` (PFM stores them from the bottom).
+void write_pfm(const std::string& path, int width, int height, std::size_t channels,
+               const std::vector<float>& data) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) throw Error("cannot write " + path);
-  std::fprintf(f, "PF\n%d %d\n-1.0\n", img.width, img.height);
+  std::fprintf(f, "%s\n%d %d\n-1.0\n", channels == 3 ? "PF" : "Pf", width, height);
+  const std::size_t row = channels * std::size_t(width);
   bool ok = true;
-  for (int y = img.height - 1; y >= 0; --y)
-    ok &= std::fwrite(img.rgb.data() + 3 * std::size_t(y) * std::size_t(img.width), sizeof(float),
-                      3 * std::size_t(img.width), f) == 3 * std::size_t(img.width);
+  for (int y = height - 1; y >= 0; --y)
+    ok &= std::fwrite(data.data() + row * std::size_t(y), sizeof(float), row, f) == row;
   ok &= std::fclose(f) == 0;
   if (!ok) throw Error("cannot write " + path);
 }
 
-std::string variance_path(const std::string& pfm) {
-  return pfm.substr(0, pfm.size() - 4) + ".variance.pfm";
+std::string layer_path(const std::string& pfm, const std::string& layer) {
+  return pfm.substr(0, pfm.size() - 4) + "." + layer + ".pfm";
 }
 
 std::string temporary_name(const std::string& path) {
@@ -173,25 +186,30 @@ unsigned char png_encode(float linear, const PngOptions& png) {
 
 std::vector<OutputFile> image_files(const std::vector<std::string>& paths, const ImageRgb& image,
                                     const std::map<std::string, std::string>& exr_attributes,
-                                    const PngOptions& png, const ImageRgb* variance) {
+                                    const PngOptions& png, const std::vector<ImageLayer>& layers) {
   // The lambdas refer to the caller's image, attributes and options, which outlive write_files.
   std::vector<OutputFile> files;
   for (const auto& path : paths) {
     const std::string ext = extension_of(path);
     if (ext == ".exr")
-      files.push_back({path, [&image, &exr_attributes, variance](const std::string& temp) {
-                         write_exr(temp, image, exr_attributes, variance);
+      files.push_back({path, [&image, &exr_attributes, &layers](const std::string& temp) {
+                         write_exr(temp, image, exr_attributes, layers);
                        }});
     else if (ext == ".png")
       files.push_back(
           {path, [&image, &png](const std::string& temp) { write_png(temp, image, png); }});
     else if (ext == ".pfm")
-      files.push_back({path, [&image](const std::string& temp) { write_pfm(temp, image); }});
+      files.push_back({path, [&image](const std::string& temp) {
+                         write_pfm(temp, image.width, image.height, 3, image.rgb);
+                       }});
     else
       throw Error(path + ": unsupported output format (use .exr, .png or .pfm)");
-    if (ext == ".pfm" && variance)
-      files.push_back({variance_path(path),
-                       [variance](const std::string& temp) { write_pfm(temp, *variance); }});
+    if (ext == ".pfm")
+      for (const ImageLayer& layer : layers)
+        files.push_back({layer_path(path, layer.name), [&image, &layer](const std::string& temp) {
+                           write_pfm(temp, image.width, image.height, layer.channels.size(),
+                                     layer.data);
+                         }});
   }
   return files;
 }
@@ -219,8 +237,8 @@ void write_files(const std::vector<OutputFile>& files, bool signals_remove_and_e
 
 void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
                   const std::map<std::string, std::string>& exr_attributes, const PngOptions& png,
-                  const ImageRgb* variance) {
-  write_files(image_files(paths, image, exr_attributes, png, variance));
+                  const std::vector<ImageLayer>& layers) {
+  write_files(image_files(paths, image, exr_attributes, png, layers));
 }
 
 ImageRgb read_exr(const std::string& path, const std::string& layer) {

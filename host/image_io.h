@@ -39,19 +39,29 @@ struct OutputFile {
 // wp::Error naming the file.
 void write_files(const std::vector<OutputFile>& files, bool signals_remove_and_exit = true);
 
-// The image outputs among `paths` (.exr, .png, .pfm; with `variance`, a .pfm's companion
-// .variance.pfm) as OutputFiles for write_files. Throws wp::Error for any other extension.
+// An image beside the main one (the variance, an AOV): channels.size() floats per pixel (1 or 3),
+// rows from the top, at the main image's size. EXR outputs hold it as the layer `name` (channels
+// name.C for each C in `channels`); a PFM output X.pfm gets X.name.pfm beside it (a colour PFM
+// for 3 channels, a greyscale one for 1); PNG outputs leave it out.
+struct ImageLayer {
+  std::string name;
+  std::vector<std::string> channels;
+  std::vector<float> data;
+};
+
+// The image outputs among `paths` (.exr, .png, .pfm, with `layers` as above) as OutputFiles for
+// write_files. Throws wp::Error for any other extension.
 std::vector<OutputFile> image_files(const std::vector<std::string>& paths, const ImageRgb& image,
                                     const std::map<std::string, std::string>& exr_attributes,
-                                    const PngOptions& png = {}, const ImageRgb* variance = nullptr);
+                                    const PngOptions& png = {},
+                                    const std::vector<ImageLayer>& layers = {});
 
-// Writes each of `paths` (by extension: .exr or .png) atomically as a set. Throws wp::Error naming
-// the file on failure (an unknown extension, an unwritable folder), after removing what it wrote.
-// With `variance`, EXR files also get the layer "variance" (channels variance.R/G/B): the
-// variance of each pixel's estimate; a PFM file x.pfm gets a companion x.variance.pfm.
+// Writes each of `paths` (by extension: .exr, .png or .pfm; `layers` as above) atomically as a
+// set. Throws wp::Error naming the file on failure (an unknown extension, an unwritable folder),
+// after removing what it wrote.
 void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
                   const std::map<std::string, std::string>& exr_attributes,
-                  const PngOptions& png = {}, const ImageRgb* variance = nullptr);
+                  const PngOptions& png = {}, const std::vector<ImageLayer>& layers = {});
 
 // Reads an OpenEXR file's R, G, B channels (of `layer`, e.g. "variance", when given) as linear
 // float. Throws wp::Error on failure, a missing layer included.

@@ -56,6 +56,7 @@ struct CliOptions {
   std::string checkpoint;
   double checkpoint_every = 60;
   std::string resume;
+  std::vector<std::string> aovs;  // --aov, in the order given
   double progress_every = 10;
   bool json = false;
   bool quiet = false;
@@ -232,9 +233,8 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 // Writes every output as one set (image_io.h, write_files): images by extension from `film`'s
-// mean (and variance), .wpfilm files from `film` itself.
-void write_outputs(const CliOptions& cli, const wp::Film& film, const wp::ImageRgb& image,
-                   const wp::ImageRgb& variance,
+// mean, with the layers asked for (--variance, --aov), and .wpfilm files from `film` itself.
+void write_outputs(const CliOptions& cli, const wp::Film& film,
                    const std::map<std::string, std::string>& exr_attributes) {
   wp::PngOptions png;
   png.exposure = cli.exposure;
@@ -242,8 +242,18 @@ void write_outputs(const CliOptions& cli, const wp::Film& film, const wp::ImageR
   std::vector<std::string> images;
   for (const auto& o : cli.outputs)
     if (!is_film(o)) images.push_back(o);
-  std::vector<wp::OutputFile> files =
-      wp::image_files(images, image, exr_attributes, png, cli.variance ? &variance : nullptr);
+  wp::FilmImages film_images = film.images();
+  const wp::ImageRgb image{film.info().width, film.info().height, std::move(film_images.mean)};
+  std::vector<wp::ImageLayer> layers;
+  if (cli.variance)
+    layers.push_back({"variance", {"R", "G", "B"}, std::move(film_images.variance)});
+  for (const std::string& aov : cli.aovs) {  // in the order given
+    if (!film.info().aov) throw wp::Error("--aov " + aov + ": the film holds no AOVs");
+    if (aov == "albedo") layers.push_back({aov, {"R", "G", "B"}, film_images.albedo});
+    if (aov == "normal") layers.push_back({aov, {"X", "Y", "Z"}, film_images.normal});
+    if (aov == "depth") layers.push_back({aov, {"Z"}, film_images.depth});
+  }
+  std::vector<wp::OutputFile> files = wp::image_files(images, image, exr_attributes, png, layers);
   for (const auto& o : cli.outputs)
     if (is_film(o)) files.push_back({o, [&film](const std::string& temp) { film.write(temp); }});
   wp::write_files(files);
@@ -267,6 +277,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   if (!cli.checkpoint.empty()) check_outputs({cli.checkpoint});
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
+  settings.aov = !cli.aovs.empty();
   settings.scene_buffer_bytes = cli.scene_buffer_kib * 1024;
   settings.strategy = cli.strategy == "nee"    ? wp::Strategy::kNee
                       : cli.strategy == "bsdf" ? wp::Strategy::kBsdf
@@ -402,10 +413,7 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
 
   wp::Rendered& result = *part.result;
   result.film = std::move(all.film);
-  if (ranks.size() > 1) {  // the image and report of every rank's samples
-    wp::FilmImages images = result.film.images();
-    result.image = {settings.width, settings.height, std::move(images.mean)};
-    result.variance = {settings.width, settings.height, std::move(images.variance)};
+  if (ranks.size() > 1) {  // the report of every rank's samples
     result.report.render_seconds = all.render_seconds;
     result.report.rays = all.rays;
     result.report.nonfinite_samples = result.film.info().nonfinite_samples;
@@ -415,7 +423,7 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
 
   auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
   attributes["wavepath:render_key"] = result.film.info().key;
-  write_outputs(cli, result.film, result.image, result.variance, attributes);
+  write_outputs(cli, result.film, attributes);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (result.report.nonfinite_samples > 0)
@@ -482,10 +490,7 @@ int merge_command(CliOptions& cli) {
     }
   }
   const wp::FilmInfo& info = merged.info();
-  wp::FilmImages images = merged.images();
-  const wp::ImageRgb image{info.width, info.height, std::move(images.mean)};
-  const wp::ImageRgb variance{info.width, info.height, std::move(images.variance)};
-  write_outputs(cli, merged, image, variance, wp::film_exr_attributes(info));
+  write_outputs(cli, merged, wp::film_exr_attributes(info));
   if (cli.json) {
     std::cout << "{\"parts\":" << parts.size() << ",\"spp\":" << info.samples()
               << ",\"sample_begin\":" << info.sample_begin << ",\"sample_end\":" << info.sample_end
@@ -629,6 +634,16 @@ int main(int argc, char** argv) {
   render->add_flag("--variance", cli.variance,
                    "Also write the variance of each pixel's estimate (sample variance / spp): the "
                    "layer variance.R/G/B in EXR output, X.variance.pfm beside X.pfm");
+  render
+      ->add_option("--aov", cli.aovs,
+                   "Also write these of the first surface that is not a perfect mirror or smooth "
+                   "glass, averaged over the pixel's samples (comma-separated): albedo (base "
+                   "colour; the background's for a miss), normal (world-space shading normal on "
+                   "the camera's side, not renormalised), depth (metres from the camera to the "
+                   "first hit, 0 for a miss): EXR layers albedo.R/G/B, normal.X/Y/Z, depth.Z; "
+                   "X.albedo.pfm etc. beside X.pfm; kept in .wpfilm outputs")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"albedo", "normal", "depth"}));
   render->add_flag("--profile", settings.profile, "Time each kernel (adds stage times to --json)");
   render->add_flag("--json", cli.json,
                    "Print a JSON summary as the last line of stdout (spp, sample_begin, "
@@ -655,6 +670,11 @@ int main(int argc, char** argv) {
   merge->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
   merge->add_flag("--variance", cli.variance,
                   "Also write the variance of each pixel's estimate (as render --variance)");
+  merge
+      ->add_option("--aov", cli.aovs,
+                   "Also write these AOVs, which the films must hold (as render --aov)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"albedo", "normal", "depth"}));
   merge->add_flag("--json", cli.json,
                   "Print a JSON summary (parts, spp, sample_begin, sample_end, width, height, "
                   "device, nonfinite_samples, outputs) as the last line of stdout");

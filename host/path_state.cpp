@@ -4,7 +4,7 @@
 
 namespace wp {
 
-PathStateLayout path_state_layout(std::size_t capacity) {
+PathStateLayout path_state_layout(std::size_t capacity, bool aov) {
   using namespace dev;
   PathStateLayout s;
   std::size_t offset = 0;
@@ -17,7 +17,9 @@ PathStateLayout path_state_layout(std::size_t capacity) {
     return static_cast<uint>(at);
   };
 #define WP_PATH_FIELD(type, name, description) s.layout.name = place(sizeof(type));
+#define WP_PATH_AOV_FIELD(type, name, description) s.layout.name = place(aov ? sizeof(type) : 0);
 #include "kernels/shared/path_state.def"
+#undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
   s.layout.capacity = static_cast<uint>(capacity);
   s.bytes = offset;

@@ -14,6 +14,7 @@ struct PathStateLayout {
   std::size_t bytes_per_path = 0;
 };
 
-PathStateLayout path_state_layout(std::size_t capacity);
+// `aov`: with the AOV fields (WP_PATH_AOV_FIELD), else those take no memory.
+PathStateLayout path_state_layout(std::size_t capacity, bool aov = false);
 
 }  // namespace wp

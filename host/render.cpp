@@ -83,7 +83,7 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
     << ";light_select=" << (s.light_select == LightSelect::kPower ? "power" : "uniform")
     << ";camera=" << s.camera << ";features=" << (s.all_features ? "all" : "scene")
     << ";bvh_width=" << bvh_width << ";spatial_splits=" << (spatial_splits ? 1 : 0)
-    << ";kernels=" << hex64(kernel_digest);
+    << ";aov=" << (s.aov ? 1 : 0) << ";kernels=" << hex64(kernel_digest);
   return k.str();
 }
 
@@ -147,6 +147,7 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   FilmInfo info;
   info.width = settings.width;
   info.height = settings.height;
+  info.aov = settings.aov;
   info.sample_begin = begin;
   info.key = render_key(scene, settings, bvh_options.width, bvh_options.spatial_splits,
                         wavefront.source_digest());

@@ -21,6 +21,7 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
   o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
+  if (s.aov) o += " -D WP_AOV=1";
   return o;
 }
 
@@ -61,7 +62,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   features_ =
       settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
   options_ = program_options(features_, settings, bvh.width);
-  path_state_ = path_state_layout(wave_size_);
+  path_state_ = path_state_layout(wave_size_, settings.aov);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
 
@@ -91,7 +92,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     queue_slots_ =
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
     counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
-    const std::size_t film_words = pixels * WP_FILM_WORDS_PER_PIXEL;
+    const std::size_t film_words = pixels * WP_FILM_WORDS(settings.aov);
     film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
     // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
     // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every

@@ -35,6 +35,8 @@ struct RenderSettings {
   // The render takes sample indices [sample_begin, sample_begin + spp), within [0, 2^20): a
   // part of a longer render, whose films merge exactly (host/film.h).
   int sample_begin = 0;
+  // Record albedo, normal and depth per sample too (AOVs, kernels/shared/film.h; FilmImages).
+  bool aov = false;
   int max_depth = 12;  // scattering events per path at most
   // Russian roulette from this many scattering events on (>= max_depth: off); 5 from the study in
   // docs/accuracy.md ("Russian roulette"): less variance per sample than 3, the same work or less

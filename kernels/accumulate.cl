@@ -34,16 +34,34 @@ inline void film_add_value(__global ulong* px, uint channel, float v) {
   film_add128(px + WP_FILM_SQUARES(channel), (sq_hi << 32) | (sq_lo >> 32), sq_hi >> 32);
 }
 
+/* The sums' stride: 12 words per pixel, 26 with AOVs. */
+#define WP_FILM_STRIDE WP_FILM_WORDS(WP_AOV)
+
+#if WP_AOV
+/* Adds one sample's AOVs: albedo, normal + 1 and depth, one 128-bit sum each (shared/film.h). */
+inline void film_add_aovs(__global ulong* px, float4 albedo, float4 normal) {
+  const float a[3] = {albedo.x, albedo.y, albedo.z}, n[3] = {normal.x, normal.y, normal.z};
+  for (uint c = 0; c < 3u; ++c) {
+    film_add128(px + WP_FILM_ALBEDO(c), convert_ulong_sat_rte(a[c] * 0x1p32f), 0ul);
+    film_add128(px + WP_FILM_NORMAL(c), convert_ulong_sat_rte((n[c] + 1.0f) * 0x1p32f), 0ul);
+  }
+  film_add128(px + WP_FILM_DEPTH, convert_ulong_sat_rte(albedo.w * 0x1p32f), 0ul);
+}
+#endif
+
 __kernel void accumulate(WP_STAGE_PARAMS, __global ulong* film) {
   WP_STAGE_BIND;
   const uint slot = get_global_id(0);
   if (slot >= launch.path_count) return;
+  __global ulong* px = film + (size_t)paths.info[slot].x * WP_FILM_STRIDE;
+#if WP_AOV /* every sample once, also one whose radiance is dropped below */
+  film_add_aovs(px, paths.aov_albedo[slot], paths.aov_normal[slot]);
+#endif
   const float3 l = paths.radiance[slot].xyz;
   if (!all(isfinite(l))) {
     count_nonfinite(queues);
     return;
   }
-  __global ulong* px = film + (size_t)paths.info[slot].x * WP_FILM_WORDS_PER_PIXEL;
   film_add_value(px, 0u, l.x);
   film_add_value(px, 1u, l.y);
   film_add_value(px, 2u, l.z);

@@ -51,4 +51,10 @@
 #define WP_MIS_POWER 1
 #endif
 
+/* AOVs: 1 records each sample's albedo, normal and depth (path_state.def, shade_surface.cl)
+ * and adds them to the film (shared/film.h); 0 (the default) compiles none of it. */
+#ifndef WP_AOV
+#define WP_AOV 0
+#endif
+
 #endif /* WP_FEATURES_H */

@@ -22,6 +22,10 @@ __kernel void generate_camera_rays(WP_STAGE_PARAMS) {
   paths.throughput[slot] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
   paths.radiance[slot] = (float4)(0.0f, 0.0f, 0.0f, 1.0f); /* w: eta scale (roulette_compact) */
   paths.info[slot] = (uint4)(pixel, 0u, 0u, 0u);
+#if WP_AOV
+  paths.aov_albedo[slot] = (float4)(0.0f);
+  paths.aov_normal[slot] = (float4)(0.0f);
+#endif
   queues.slots[launch.queue_out * queues.capacity + slot] = slot;
   if (slot == 0) queues.counters[launch.queue_out] = launch.path_count;
 }

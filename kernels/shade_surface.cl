@@ -10,6 +10,18 @@
 #include "mis.h"
 #include "surface.h"
 
+#if WP_AOV
+/* Records the AOVs of the path in `slot` once (path_state.def): at the first surface whose BSDF is
+ * not delta lobes alone, so that mirrors and smooth glass show what they reflect or let through,
+ * as OIDN and OptiX want their albedo and normal inputs; or the background, for a path that leaves
+ * the scene first. The depth (w) is set apart, by the camera ray. */
+inline void aov_record(Paths paths, uint slot, float3 albedo, float3 normal) {
+  if (paths.aov_normal[slot].w != 0.0f) return;
+  paths.aov_albedo[slot] = (float4)(albedo, paths.aov_albedo[slot].w);
+  paths.aov_normal[slot] = (float4)(normal, 1.0f);
+}
+#endif
+
 __kernel void shade_surface(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
   uint slot;
@@ -19,13 +31,22 @@ __kernel void shade_surface(WP_STAGE_PARAMS) {
   const float3 ray_d = paths.ray_d[slot].xyz;
   if (!(hit.x < INFINITY)) {
     const float w = mis_weight_bsdf_hit(beta.w, environment_light_pdf(&scene, ray_d));
-    paths.radiance[slot].xyz += beta.xyz * env_radiance(&scene, ray_d) * w;
+    const float3 le = env_radiance(&scene, ray_d);
+    paths.radiance[slot].xyz += beta.xyz * le * w;
+#if WP_AOV
+    aov_record(paths, slot, clamp(le, 0.0f, 1.0f), (float3)(0.0f));
+#endif
     return;
   }
   const uint tri = as_uint(hit.w);
   const uint4 tv = scene.tri_vertices[tri];
   bool front;
   const Surface s = resolve_surface(&scene, tv, hit.y, hit.z, ray_d, &front);
+#if WP_AOV
+  if (paths.info[slot].y == 0u) /* from the camera, panes passed on the way included */
+    paths.aov_albedo[slot].w = hit.x + as_float(paths.info[slot].w);
+  if (!bsdf_only_delta(&s)) aov_record(paths, slot, s.color, s.ns);
+#endif
 #if WP_FEATURE_VOLUME
   /* A ray that reaches the back of a volume travelled inside it: Beer-Lambert absorption with
    * transmittance attenuationColor^(distance / attenuationDistance) (KHR_materials_volume). */

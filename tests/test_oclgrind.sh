@@ -132,7 +132,7 @@ models=$assets/models
 
 # In the repository: both BVH layouts, all features, several waves of several work-groups (and a
 # partial last group), an environment map, glass and mirrors, punctual lights, degenerate
-# triangles, and scenes split over several scene buffers (3 each, --json's scene_buffers).
+# triangles, scenes split over several scene buffers (3 each, --json's scene_buffers), and AOVs.
 check cornell_bvh2 "$scenes/cornell_box.gltf" --bvh-width 2
 check cornell_bvh8_all "$scenes/cornell_box.gltf" --bvh-width 8 --features all --local-size 16
 check point_waves "$scenes/cornell_box_point.gltf" --bvh-width 8 --spp 2 --wave-size 20 \
@@ -140,7 +140,7 @@ check point_waves "$scenes/cornell_box_point.gltf" --bvh-width 8 --spp 2 --wave-
 check cornell_split "$scenes/cornell_box.gltf" --bvh-width 8 --scene-buffer-kib 4
 check env_sun_split "$scenes/failure/env_sun.gltf" --env "$scenes/failure/env_sun.hdr" \
   --bvh-width 2 --scene-buffer-kib 2048
-check caustics "$scenes/failure/caustics.gltf" --bvh-width 8
+check caustics "$scenes/failure/caustics.gltf" --bvh-width 8 --aov albedo,normal,depth
 check punctual "$scenes/failure/punctual.gltf" --bvh-width 8 --features all
 check degenerate "$scenes/failure/degenerate.gltf" --bvh-width 2 --local-size 16
 

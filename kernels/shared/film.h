@@ -12,7 +12,7 @@
  * S < 2^84 and Q < 2^116: no sum can overflow 128 bits, whatever the values (saturated ones
  * included); Q would first overflow after 2^32 samples.
  *
- * Layout: WP_FILM_WORDS_PER_PIXEL 64-bit words per pixel, pixels row by row from the top; each
+ * Layout: WP_FILM_WORDS_PER_PIXEL 64-bit words per pixel (WP_FILM_WORDS(aov) with AOVs, below), pixels row by row from the top; each
  * 128-bit value is two words, the low word first: S of R, G, B (WP_FILM_SUM(c)), then Q of R, G, B
  * (WP_FILM_SQUARES(c)). 96 bytes per pixel.
  */
@@ -24,5 +24,15 @@
 #define WP_FILM_WORDS_PER_PIXEL 12u
 #define WP_FILM_SUM(c) (2u * (c))          /* word offset of S (low word) of channel c */
 #define WP_FILM_SQUARES(c) (6u + 2u * (c)) /* word offset of Q (low word) of channel c */
+
+/* With AOVs (WP_AOV, RenderSettings::aov) 14 more words per pixel follow the 12: 128-bit sums,
+ * one value per sample, of round(v * 2^32) saturated as above, for the albedo's R, G, B
+ * (WP_FILM_ALBEDO(c)), the normal's X + 1, Y + 1, Z + 1 (WP_FILM_NORMAL(c); the 1 keeps them
+ * non-negative) and the depth in metres (WP_FILM_DEPTH). 208 bytes per pixel. */
+#define WP_FILM_AOV_WORDS 14u
+#define WP_FILM_ALBEDO(c) (12u + 2u * (c))
+#define WP_FILM_NORMAL(c) (18u + 2u * (c))
+#define WP_FILM_DEPTH 24u
+#define WP_FILM_WORDS(aov) ((aov) ? WP_FILM_WORDS_PER_PIXEL + WP_FILM_AOV_WORDS : WP_FILM_WORDS_PER_PIXEL)
 
 #endif /* WP_SHARED_FILM_H */
