@@ -5,14 +5,10 @@
 #include <string>
 
 #include "host/error.h"
+#include "host/gltf_values.h"
 
 namespace wp::gltf {
 namespace {
-
-float finite(double value, const std::string& where, const char* field) {
-  if (!std::isfinite(value)) throw Error(where + ": " + field + " is not a finite number");
-  return static_cast<float>(value);
-}
 
 // The object of material extension `name`, or null when the material does not use it.
 const tinygltf::Value* extension(const tinygltf::Material& m, const char* name,
@@ -67,12 +63,13 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
   if (pbr.baseColorFactor.size() != 4)
     throw Error(where + ": baseColorFactor needs 4 numbers, has " +
                 std::to_string(pbr.baseColorFactor.size()));
+  // Factors outside glTF's [0, 1] are errors (as for the Khronos validator): a negative colour
+  // gave negative radiance, which the film cannot hold (kernels/shared/film.h).
   for (int i = 0; i < 4; ++i)
-    out.base_color[i] =
-        finite(pbr.baseColorFactor[static_cast<std::size_t>(i)], where, "baseColorFactor");
-  // Factors outside glTF's [0, 1] ranges would only make the shading code misbehave.
-  out.metallic = std::clamp(finite(pbr.metallicFactor, where, "metallicFactor"), 0.0f, 1.0f);
-  out.roughness = std::clamp(finite(pbr.roughnessFactor, where, "roughnessFactor"), 0.0f, 1.0f);
+    out.base_color[i] = in_range(pbr.baseColorFactor[static_cast<std::size_t>(i)], 0.0, 1.0, where,
+                                 "baseColorFactor");
+  out.metallic = in_range(pbr.metallicFactor, 0.0, 1.0, where, "metallicFactor");
+  out.roughness = in_range(pbr.roughnessFactor, 0.0, 1.0, where, "roughnessFactor");
 
   if (in.emissiveFactor.size() != 3)  // tinygltf fills [0, 0, 0] when absent
     throw Error(where + ": emissiveFactor needs 3 numbers, has " +
@@ -81,22 +78,24 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
       extension_number(in, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f, where);
   if (strength < 0.0f) throw Error(where + ": negative emissiveStrength");
   for (int i = 0; i < 3; ++i)
-    out.emission[i] =
-        finite(in.emissiveFactor[static_cast<std::size_t>(i)], where, "emissiveFactor") * strength;
+    out.emission[i] = in_range(in.emissiveFactor[static_cast<std::size_t>(i)], 0.0, 1.0, where,
+                               "emissiveFactor") *
+                      strength;
 
   out.double_sided = in.doubleSided;
   out.alpha_mode = alpha_mode(in.alphaMode, where);
   out.alpha_cutoff = finite(in.alphaCutoff, where, "alphaCutoff");
   out.ior = extension_number(in, "KHR_materials_ior", "ior", 1.5f, where);
-  out.transmission = std::clamp(
-      extension_number(in, "KHR_materials_transmission", "transmissionFactor", 0.0f, where), 0.0f,
-      1.0f);
+  out.transmission = in_range(
+      extension_number(in, "KHR_materials_transmission", "transmissionFactor", 0.0f, where), 0.0,
+      1.0, where, "transmissionFactor");
   out.unlit = in.extensions.count("KHR_materials_unlit") != 0;
   read_volume(in, where, out);
   // KHR_materials_specular: the factor scales the dielectric Fresnel term (kernels/bsdf.h);
   // specularColorFactor and the two textures are not applied yet.
-  out.specular = std::clamp(
-      extension_number(in, "KHR_materials_specular", "specularFactor", 1.0f, where), 0.0f, 1.0f);
+  out.specular =
+      in_range(extension_number(in, "KHR_materials_specular", "specularFactor", 1.0f, where), 0.0,
+               1.0, where, "specularFactor");
 }
 
 // Colour textures (base colour, emissive) are sRGB-encoded; the others hold linear data.

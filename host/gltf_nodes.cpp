@@ -10,6 +10,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "host/error.h"
+#include "host/gltf_values.h"
 
 namespace wp::gltf {
 namespace {
@@ -24,11 +25,6 @@ bool present(const std::vector<double>& v, std::size_t size, const std::string& 
   for (const double x : v)
     if (!std::isfinite(x)) throw Error(where + ": " + field + " is not finite");
   return true;
-}
-
-float finite(double value, const std::string& where, const char* field) {
-  if (!std::isfinite(value)) throw Error(where + ": " + field + " is not a finite number");
-  return static_cast<float>(value);
 }
 
 // Unit direction of `v`, or `fallback` when `v` has no direction (a zero scale).
@@ -122,12 +118,18 @@ PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dma
     throw Error(where + ": unknown type '" + in.type + "'");
   }
   glm::vec3 color(1.0f);
-  if (present(in.color, 3, where, "color")) color = glm::vec3(glm::make_vec3(in.color.data()));
-  out.intensity = color * finite(in.intensity, where, "intensity");
+  if (present(in.color, 3, where, "color"))
+    for (int i = 0; i < 3; ++i)
+      color[i] = in_range(in.color[static_cast<std::size_t>(i)], 0.0, 1.0, where, "color");
+  out.intensity = color * in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
   out.range = finite(in.range, where, "range");
-  // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out.
-  out.inner_cone = finite(in.spot.innerConeAngle, where, "innerConeAngle");
-  out.outer_cone = finite(in.spot.outerConeAngle, where, "outerConeAngle");
+  // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out; the
+  // extension asks 0 <= inner < outer <= pi/2.
+  out.inner_cone = in_range(in.spot.innerConeAngle, 0.0, M_PI / 2, where, "innerConeAngle");
+  out.outer_cone = in_range(in.spot.outerConeAngle, 0.0, M_PI / 2, where, "outerConeAngle");
+  if (out.type == LightType::kSpot && !(out.inner_cone < out.outer_cone))
+    throw Error(where + ": innerConeAngle " + number_text(in.spot.innerConeAngle) +
+                " is not below outerConeAngle " + number_text(in.spot.outerConeAngle));
   out.position = glm::vec3(world[3]);
   out.direction = glm::vec3(unit_or(-glm::dmat3(world)[2], glm::dvec3(0.0, 0.0, -1.0)));
   return out;

@@ -1045,6 +1045,53 @@ TEST(GltfLoader, OutOfRangeDataIsAnError) {
   }
 }
 
+// Values outside glTF's ranges are errors, as for the Khronos validator: a negative base colour
+// or emission gave negative radiance, which the fixed-point film silently saturated to 0; a
+// metallic factor of 1.5 was clamped without a word.
+TEST(GltfLoader, OutOfRangeFactorsAreErrors) {
+  for (const auto& [material, cause] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"pbrMetallicRoughness":{"baseColorFactor":[0.5,-0.1,0.5,1]}})",
+            "baseColorFactor -0.1 is outside [0, 1]"},
+           {R"({"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1.2]}})",
+            "baseColorFactor 1.2 is outside [0, 1]"},
+           {R"({"pbrMetallicRoughness":{"metallicFactor":1.5}})",
+            "metallicFactor 1.5 is outside [0, 1]"},
+           {R"({"pbrMetallicRoughness":{"roughnessFactor":-1}})",
+            "roughnessFactor -1 is outside [0, 1]"},
+           {R"({"emissiveFactor":[2,0,0]})", "emissiveFactor 2 is outside [0, 1]"},
+           {R"({"extensions":{"KHR_materials_transmission":{"transmissionFactor":1.01}}})",
+            "transmissionFactor 1.01 is outside [0, 1]"},
+           {R"({"extensions":{"KHR_materials_specular":{"specularFactor":-0.5}}})",
+            "specularFactor -0.5 is outside [0, 1]"},
+       }) {
+    Gltf g = one_triangle("");
+    g.materials = {material};
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, -1, 0) + "]}"};
+    expect_error(g.write("range.gltf"), "material 0 '': " + cause);
+  }
+  // The bounds themselves are valid.
+  Gltf edge = one_triangle("");
+  edge.materials = {R"({"pbrMetallicRoughness":{"baseColorFactor":[0,1,0,1],"metallicFactor":1,)"
+                    R"("roughnessFactor":0},"emissiveFactor":[1,0,1]})"};
+  edge.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, -1, 0) + "]}"};
+  EXPECT_NO_THROW(wp::load_gltf(edge.write("edge.gltf")));
+
+  for (const auto& [light, cause] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"type":"point","intensity":-2})", "intensity -2 is outside [0, inf]"},
+           {R"({"type":"point","color":[1,1.5,1]})", "color 1.5 is outside [0, 1]"},
+           {R"({"type":"spot","spot":{"innerConeAngle":0.5,"outerConeAngle":0.5}})",
+            "innerConeAngle 0.5 is not below outerConeAngle 0.5"},
+           {R"({"type":"spot","spot":{"outerConeAngle":2}})",
+            "outerConeAngle 2 is outside [0, 1.5708]"},
+       }) {
+    Gltf g = one_triangle("");
+    g.top = R"("extensionsUsed":["KHR_lights_punctual"])";
+    g.lights = {light};
+    g.node(R"("extensions":{"KHR_lights_punctual":{"light":0}})", true);
+    expect_error(g.write("light_range.gltf"), "light 0 '': " + cause);
+  }
+}
+
 // JSON nested 20,000 deep overflowed the stack in tinygltf (SIGSEGV); it is refused up front, in
 // .gltf text and in a .glb's JSON chunk. Brackets inside strings (with escaped quotes) do not
 // count.
