@@ -10,9 +10,8 @@
  *       count, the tests require 0) and weighs as 0 in the mean (S / 2^32 / spp).
  *
  * Radiance is never negative for a valid scene (emission, lights, the background and the
- * environment are non-negative, and so are BSDF values, cosines and MIS weights); the negative
- * values that glTF files with out-of-range factors (which the loader accepts) could give
- * saturate to 0.
+ * environment are non-negative, and so are BSDF values, cosines and MIS weights; the loader
+ * refuses factors outside glTF's ranges). A negative value would saturate to 0.
  *
  * Each pixel is in one slot of a wave and waves run one after another, so the adds need no
  * atomics. */
