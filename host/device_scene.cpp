@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -152,21 +153,6 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
                        std::uint64_t max_buffer) {
   const std::size_t tris = scene.triangle_count();
   const std::size_t verts = scene.positions.size();
-  std::vector<dev::uint4> tri_vertices(tris);
-  for (std::size_t i = 0; i < tris; ++i)
-    tri_vertices[i] = {scene.indices[3 * i], scene.indices[3 * i + 1], scene.indices[3 * i + 2],
-                       scene.triangle_material[i]};
-  std::vector<dev::float4> positions(verts), normals(verts), tangents(verts), uvs(verts),
-      colors(verts);
-  for (std::size_t i = 0; i < verts; ++i) {
-    positions[i] = f4(scene.positions[i]);
-    normals[i] = f4(scene.normals[i]);
-    tangents[i] = i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
-    const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
-    const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
-    uvs[i] = {uv0.x, uv0.y, uv1.x, uv1.y};
-    colors[i] = i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
-  }
   std::vector<dev::Material> materials;
   for (const Material& m : scene.materials) materials.push_back(device_material(m));
   std::vector<dev::TextureRef> textures;
@@ -174,41 +160,71 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
   std::vector<dev::TextureImage> images;
   std::vector<dev::uint> texels;
   pack_images(scene, images, texels);
+  if (texels.size() > 0xffffffffu) throw Error(too_many_texels());
 
   PackedScene p;
   dev::SceneDesc& d = p.desc;
-  // The arrays in kArrayNames' order, each with the SceneDesc field of its offset. The BVH is in
-  // the layout the program was built for (WP_BVH_WIDTH): the same two fields either way.
+  // The arrays in kArrayNames' order, each with the SceneDesc field of its offset and what writes
+  // it in place: a copy of an array that exists, or, for the per-triangle and per-vertex arrays,
+  // their conversion straight into the buffer (no intermediate copy of gigabytes for tens of
+  // millions of triangles). The BVH is in the layout the program was built for (WP_BVH_WIDTH):
+  // the same two fields either way.
   struct Array {
-    const void* data;
     std::uint64_t bytes;
     dev::uint* offset;
+    std::function<void(unsigned char*)> write;
   };
-  const auto array = [](const auto& items, dev::uint& offset) {
-    return Array{items.data(), items.size() * sizeof(items[0]), &offset};
+  const auto copy = [](const auto& items, dev::uint& offset) {
+    const std::uint64_t bytes = items.size() * sizeof(items[0]);
+    const void* data = items.data();
+    return Array{bytes, &offset, [data, bytes](unsigned char* to) {
+                   if (bytes) std::memcpy(to, data, bytes);
+                 }};
+  };
+  // `count` elements of type T, element i made by make(i).
+  const auto convert = [](std::size_t count, dev::uint& offset, auto make) {
+    using T = decltype(make(std::size_t{0}));
+    return Array{count * sizeof(T), &offset, [count, make](unsigned char* to) {
+                   T* out = reinterpret_cast<T*>(to);
+                   for (std::size_t i = 0; i < count; ++i) out[i] = make(i);
+                 }};
   };
   std::vector<Array> arrays = {
-      bvh.width == 8 ? array(bvh.nodes8, d.bvh_nodes) : array(bvh.nodes, d.bvh_nodes),
-      bvh.width == 8 ? array(bvh.blocks, d.isect_tris) : array(bvh.triangles, d.isect_tris),
-      array(tri_vertices, d.tri_vertices),
-      array(positions, d.positions),
-      array(normals, d.normals),
-      array(tangents, d.tangents),
-      array(uvs, d.uvs),
-      array(colors, d.colors),
-      array(materials, d.materials),
-      array(textures, d.textures),
-      array(images, d.images),
-      array(texels, d.texels),
-      array(x.lights->lights, d.lights),
-      array(x.lights->alias, d.light_alias),
-      array(x.lights->tri_light, d.tri_light)};
+      bvh.width == 8 ? copy(bvh.nodes8, d.bvh_nodes) : copy(bvh.nodes, d.bvh_nodes),
+      bvh.width == 8 ? copy(bvh.blocks, d.isect_tris) : copy(bvh.triangles, d.isect_tris),
+      convert(tris, d.tri_vertices,
+              [&](std::size_t i) {
+                return dev::uint4{scene.indices[3 * i], scene.indices[3 * i + 1],
+                                  scene.indices[3 * i + 2], scene.triangle_material[i]};
+              }),
+      convert(verts, d.positions, [&](std::size_t i) { return f4(scene.positions[i]); }),
+      convert(verts, d.normals, [&](std::size_t i) { return f4(scene.normals[i]); }),
+      convert(verts, d.tangents,
+              [&](std::size_t i) {
+                return i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
+              }),
+      convert(verts, d.uvs,
+              [&](std::size_t i) {
+                const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
+                const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
+                return dev::float4{uv0.x, uv0.y, uv1.x, uv1.y};
+              }),
+      convert(verts, d.colors,
+              [&](std::size_t i) {
+                return i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
+              }),
+      copy(materials, d.materials),
+      copy(textures, d.textures),
+      copy(images, d.images),
+      copy(texels, d.texels),
+      copy(x.lights->lights, d.lights),
+      copy(x.lights->alias, d.light_alias),
+      copy(x.lights->tri_light, d.tri_light)};
   if (x.env) {
-    arrays.push_back(array(x.env->texels, d.env_texels));
-    arrays.push_back(array(x.env->marginal, d.env_marginal));
-    arrays.push_back(array(x.env->conditional, d.env_conditional));
+    arrays.push_back(copy(x.env->texels, d.env_texels));
+    arrays.push_back(copy(x.env->marginal, d.env_marginal));
+    arrays.push_back(copy(x.env->conditional, d.env_conditional));
   }
-  if (texels.size() > 0xffffffffu) throw Error(too_many_texels());
   std::vector<std::uint64_t> sizes;
   for (const Array& a : arrays) sizes.push_back(a.bytes);
   const SceneLayout layout = plan_scene_layout(sizes, max_buffer);
@@ -216,8 +232,7 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
   for (std::size_t i = 0; i < p.buffers.size(); ++i) p.buffers[i].resize(layout.buffer_bytes[i]);
   for (std::size_t i = 0; i < arrays.size(); ++i) {
     const SceneLayout::Place place = layout.places[i];
-    if (arrays[i].bytes)
-      std::memcpy(p.buffers[place.buffer].data() + place.offset, arrays[i].data, arrays[i].bytes);
+    arrays[i].write(p.buffers[place.buffer].data() + place.offset);
     *arrays[i].offset = static_cast<dev::uint>(place.offset / WP_SCENE_ALIGN);
   }
   p.buffer_map = layout.buffer_map();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <new>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -17,8 +18,30 @@
 
 namespace wp {
 
+// Bytes at a page boundary, so that a CPU device can use them in place (CL_MEM_USE_HOST_PTR:
+// PoCL then makes no copy of a scene that may be gigabytes; scene_buffers.h).
+template <class T>
+struct PageAligned {
+  using value_type = T;
+  static constexpr std::align_val_t kAlign{4096};
+  PageAligned() = default;
+  template <class U>
+  PageAligned(const PageAligned<U>&) {}
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlign)); }
+  void deallocate(T* p, std::size_t) { ::operator delete(p, kAlign); }
+  template <class U>
+  bool operator==(const PageAligned<U>&) const {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const PageAligned<U>&) const {
+    return false;
+  }
+};
+using SceneBytes = std::vector<unsigned char, PageAligned<unsigned char>>;
+
 struct PackedScene {
-  std::vector<std::vector<unsigned char>> buffers;  // 1 to WP_SCENE_BUFFERS, uploaded as they are
+  std::vector<SceneBytes> buffers;  // 1 to WP_SCENE_BUFFERS, uploaded as they are
   dev::SceneDesc desc{};
   std::uint64_t buffer_map = 0;  // the program's WP_SCENE_BUFFER_MAP (SceneLayout::buffer_map)
 };

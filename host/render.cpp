@@ -101,6 +101,40 @@ const char* stop_reason_name(StopReason reason) {
   return "unknown";
 }
 
+namespace {
+
+// Bytes of memory the system says are available (/proc/meminfo's MemAvailable), or 0 when it
+// does not say.
+std::uint64_t available_memory() {
+  std::FILE* f = std::fopen("/proc/meminfo", "r");
+  if (!f) return 0;
+  char line[256];
+  unsigned long long kib = 0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "MemAvailable: %llu kB", &kib) == 1) break;
+  std::fclose(f);
+  return std::uint64_t(kib) * 1024;
+}
+
+}  // namespace
+
+void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uint64_t available) {
+  const auto gb = [](std::uint64_t b) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f GB", double(b) / 1e9);
+    return std::string(buf);
+  };
+  if (device.gpu) {
+    if (device.global_memory && bytes > device.global_memory)
+      throw Error("scene too large for the device: it packs into " + gb(bytes) + ", " +
+                  device.name + " has " + gb(device.global_memory));
+    return;
+  }
+  if (available && bytes > available)
+    throw Error("scene too large for this machine's memory: it packs into " + gb(bytes) + ", " +
+                gb(available) + " are available");
+}
+
 int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.bvh_width) return settings.bvh_width;
   return device.gpu ? 2 : 8;
@@ -114,15 +148,21 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
   bool cached = false;
-  // A scene too large for the device's buffers (device_scene.h) fails now, not after its BVH is
-  // built (minutes for tens of millions of triangles) and cached: first with the least BVH its
-  // triangles need, then, before it is cached, with the BVH built.
+  // A scene too large for the device's buffers (device_scene.h) or its memory fails now, not
+  // after its BVH is built (minutes for tens of millions of triangles) and cached: first with the
+  // least BVH its triangles need, then, before it is cached, with the BVH built.
   const SceneCounts counts = scene_counts(scene, settings.environment.get());
   const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
-  scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer);
+  check_scene_memory(
+      scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)
+          .total_bytes(),
+      runtime.device(), available_memory());
   const bvh::Bvh bvh = bvh::build_cached(
       bvh_input(scene, flags), bvh_options, options.bvh_cache ? bvh::cache_dir() : std::string(),
-      &cached, [&](const bvh::Bvh& built) { scene_layout(counts, bvh_bytes(built), max_buffer); });
+      &cached, [&](const bvh::Bvh& built) {
+        check_scene_memory(scene_layout(counts, bvh_bytes(built), max_buffer).total_bytes(),
+                           runtime.device(), available_memory());
+      });
 
   Wavefront wavefront(runtime, scene, bvh, settings);
 

@@ -114,6 +114,12 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
 std::string render_key(const Scene& scene, const RenderSettings& settings, int bvh_width,
                        bool spatial_splits, std::uint64_t kernel_digest);
 
+// Fails (wp::Error naming both sizes) when a packed scene of `bytes` cannot be held: on a GPU
+// beyond its global memory, on a CPU device beyond `available` bytes of host memory (the packed
+// scene is host memory there, used in place; 0: unknown, not checked), where the system would
+// otherwise kill the process for memory. render() checks with /proc/meminfo's MemAvailable.
+void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uint64_t available);
+
 // Checks the ranges of user-facing settings; throws wp::Error naming the option.
 void validate(const RenderSettings& settings);
 

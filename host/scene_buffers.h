@@ -16,8 +16,11 @@ struct SceneBuffers {
   dev::SceneDesc desc{};
 };
 
-// Uploads `packed` (read-only buffers). Throws cl::Error as the allocation does.
-SceneBuffers upload_scene(const cl::Context& context, const PackedScene& packed);
+// Uploads `packed` (read-only buffers). With `in_place` the buffers use packed's memory
+// (CL_MEM_USE_HOST_PTR), which must then outlive them: on a CPU device (PoCL) that saves a copy
+// of the whole scene; a GPU copies it over either way. Throws cl::Error as the allocation does.
+SceneBuffers upload_scene(const cl::Context& context, const PackedScene& packed,
+                          bool in_place = false);
 
 // Sets WP_SCENE_PARAMS as `kernel`'s arguments from index `first`; returns the index after them.
 cl_uint set_scene_args(cl::Kernel& kernel, cl_uint first, const SceneBuffers& scene);

@@ -75,9 +75,11 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   extras.lights = &lights_;
   const cl::Context& ctx = rt_.context();
   try {
-    const PackedScene packed =
-        pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings));
-    scene_ = upload_scene(ctx, packed);
+    // On a CPU device the kernels read the packed scene in place, which therefore stays here; a
+    // GPU gets its own copy, and the host's goes at the end of this block.
+    const bool in_place = !rt_.device().gpu;
+    PackedScene packed = pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings));
+    scene_ = upload_scene(ctx, packed, in_place);
     scene_buffer_count_ = static_cast<int>(packed.buffers.size());
     for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
     // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
@@ -88,6 +90,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
                     static_cast<unsigned long long>(packed.buffer_map));
       options_ += map;
     }
+    if (in_place) packed_ = std::move(packed.buffers);
     path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
     queue_slots_ =
         cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));

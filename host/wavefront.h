@@ -169,6 +169,9 @@ class Wavefront {
   std::string options_;
   std::uint64_t source_digest_ = 0;
 
+  // The memory scene_ uses in place on a CPU device: declared first, so that it outlives the
+  // buffers.
+  std::vector<SceneBytes> packed_;
   SceneBuffers scene_;
   std::uint64_t scene_bytes_ = 0;
   int scene_buffer_count_ = 0;

@@ -264,6 +264,33 @@ TEST(PackedSize, RenderRefusesBeforeBuildingTheBvh) {
   unsetenv("WAVEPATH_CACHE_DIR");
 }
 
+// A packed scene beyond what will hold it is refused, naming both sizes, instead of an allocation
+// failure or (on a CPU device, where it is host memory) the system killing the process: a GPU's
+// global memory, a CPU device's available host memory (0: unknown, not checked).
+TEST(PackedSize, SceneMemoryIsChecked) {
+  DeviceEntry cpu, gpu;
+  cpu.name = "cpu";
+  gpu.name = "gpu";
+  gpu.gpu = true;
+  gpu.global_memory = 4'000'000'000ull;
+  const auto error = [](const auto& f) {
+    try {
+      f();
+    } catch (const wp::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error([&] { check_scene_memory(4'000'000'000ull, cpu, 4'000'000'000ull); }), "");
+  EXPECT_EQ(error([&] { check_scene_memory(1ull << 40, cpu, 0); }), "");
+  EXPECT_EQ(error([&] { check_scene_memory(8'000'000'000ull, cpu, 4'500'000'000ull); }),
+            "scene too large for this machine's memory: it packs into 8.00 GB, 4.50 GB are "
+            "available");
+  EXPECT_EQ(error([&] { check_scene_memory(4'000'000'000ull, gpu, 1); }), "");
+  EXPECT_EQ(error([&] { check_scene_memory(5'000'000'000ull, gpu, 1ull << 40); }),
+            "scene too large for the device: it packs into 5.00 GB, gpu has 4.00 GB");
+}
+
 // The kernels find every array wherever it lies: a textured, lit scene with an environment map,
 // split over several buffers, renders bit for bit as in one, with either BVH layout.
 TEST(PackedSize, SplitSceneRendersExactlyAsOne) {
