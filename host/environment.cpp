@@ -186,9 +186,81 @@ void read_hdr(const std::string& path, EnvironmentMap& env) {
   RgbeReader(path, std::move(bytes)).read(env);
 }
 
+// A data window of w x h pixels, checked before anything is allocated for it: a 417-byte file can
+// declare a 2^28-pixel window (found by tests/fuzz). Besides the texel limit of .hdr maps, the file
+// must be able to hold the window: at 6 bytes per pixel (half RGB), no EXR compression (zlib: at
+// most ~1000:1) packs more than 2048 x its size, and maps up to 16 MiB of pixels are never refused
+// on this count.
+void check_exr_window(const std::string& path, long long w, long long h, std::uint64_t file_bytes) {
+  const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
+  if (std::uint64_t(w) > kMaxMapPixels || std::uint64_t(h) > kMaxMapPixels ||
+      pixels > kMaxMapPixels)
+    throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
+                " pixels is more than the 2^28 read");
+  if (6 * pixels > 2048 * file_bytes + (std::uint64_t{16} << 20))
+    throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
+                " pixels in a file of " + std::to_string(file_bytes) +
+                " bytes: the EXR header is corrupt");
+}
+
+// The attributes of an EXR file's header(s), walked before OpenEXR reads them: each attribute's
+// size must fit in the bytes that follow it. OpenEXR allocates an unknown ("opaque") attribute's
+// stated size before reading it, so a 202-byte file stating 1.6 GB made it allocate that much
+// (fuzzing: with the sanitizers' bookkeeping, seconds per input). Names and types are
+// NUL-terminated strings of at most 255 bytes; a header ends with an empty name, a multi-part
+// file's headers with an empty header. A dataWindow is checked here too (check_exr_window): for a
+// window millions of pixels wide OpenEXR allocates line buffers before read_exr could look.
+void check_exr_attributes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
+  const auto fail = [&](const std::string& what) {
+    return Error(path + ": the EXR header is corrupt (" + what + ")");
+  };
+  if (b.size() < 8) throw fail("shorter than its magic number and version");
+  const bool multipart = (b[5] & 0x10) != 0;  // version bit 12
+  std::size_t at = 8;
+  const auto text = [&](const char* what) {
+    const std::size_t start = at;
+    while (at < b.size() && b[at] != 0 && at - start < 256) ++at;
+    if (at >= b.size() || b[at] != 0) throw fail(std::string("unterminated ") + what);
+    return at++ - start;  // its length; `at` past the NUL
+  };
+  for (int headers = 0;; ++headers) {
+    bool empty = true;
+    std::size_t name_at = at;
+    while (text("attribute name") > 0) {
+      empty = false;
+      const bool window =
+          std::strcmp(reinterpret_cast<const char*>(&b[name_at]), "dataWindow") == 0;
+      text("attribute type");
+      if (b.size() - at < 4) throw fail("truncated attribute size");
+      const std::uint32_t size = std::uint32_t(b[at]) | std::uint32_t(b[at + 1]) << 8 |
+                                 std::uint32_t(b[at + 2]) << 16 | std::uint32_t(b[at + 3]) << 24;
+      at += 4;
+      if (size > b.size() - at)
+        throw fail("an attribute states " + std::to_string(size) + " bytes, " +
+                   std::to_string(b.size() - at) + " follow");
+      if (window && size == 16) {  // box2i: xMin, yMin, xMax, yMax
+        std::int32_t v[4];
+        for (int i = 0; i < 4; ++i)
+          v[i] = static_cast<std::int32_t>(
+              std::uint32_t(b[at + 4 * i]) | std::uint32_t(b[at + 4 * i + 1]) << 8 |
+              std::uint32_t(b[at + 4 * i + 2]) << 16 | std::uint32_t(b[at + 4 * i + 3]) << 24);
+        const long long w = 1LL + v[2] - v[0], h = 1LL + v[3] - v[1];
+        if (w > 0 && h > 0) check_exr_window(path, w, h, b.size());
+      }
+      at += size;
+      name_at = at;
+    }
+    if (!multipart || (empty && headers > 0)) return;
+  }
+}
+
 // OpenEXR: R, G and B of the data window (which may start anywhere), as 32-bit floats whatever
 // their stored type. Row 0 of the data window is the top of the map.
 void read_exr(const std::string& path, EnvironmentMap& env) {
+  check_exr_attributes(path);
   try {
     Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();
@@ -198,20 +270,8 @@ void read_exr(const std::string& path, EnvironmentMap& env) {
     const Imath::Box2i dw = header.dataWindow();
     const long long w = 1LL + dw.max.x - dw.min.x, h = 1LL + dw.max.y - dw.min.y;
     if (w <= 0 || h <= 0) throw Error(path + ": the image is empty");
-    // Checked before allocating: a 417-byte file can declare a 2^28-pixel window (found by
-    // tests/fuzz). Besides the texel limit of .hdr maps, the file must be able to hold the
-    // window: at 6 bytes per pixel (half RGB), no EXR compression (zlib: at most ~1000:1) packs
-    // more than 2048 x its size, and maps up to 16 MiB of pixels are never refused on this count.
-    const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
-    const std::uint64_t file_bytes = std::filesystem::file_size(path);
-    if (std::uint64_t(w) > kMaxMapPixels || std::uint64_t(h) > kMaxMapPixels ||
-        pixels > kMaxMapPixels)
-      throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
-                  " pixels is more than the 2^28 read");
-    if (6 * pixels > 2048 * file_bytes + (std::uint64_t{16} << 20))
-      throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
-                  " pixels in a file of " + std::to_string(file_bytes) +
-                  " bytes: the EXR header is corrupt");
+    // Again as OpenEXR read it (the walk above checked the first dataWindow it met).
+    check_exr_window(path, w, h, std::filesystem::file_size(path));
     env.width = static_cast<int>(w);
     env.height = static_cast<int>(h);
     env.texels.assign(std::size_t(w) * std::size_t(h), glm::vec4(0.0f));

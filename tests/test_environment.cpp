@@ -219,6 +219,26 @@ TEST(EnvironmentLoad, ExrHugeDataWindowIsAnError) {
   }
 }
 
+// An attribute stating more bytes than the file has (fuzzing: 1.6 GB in a 202-byte file, which
+// OpenEXR allocated before reading) is refused by the header walk before OpenEXR sees the file.
+TEST(EnvironmentLoad, ExrAttributeLongerThanTheFileIsAnError) {
+  const std::string path = temp_file("long_attribute.exr");
+  std::string bytes("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  bytes += std::string("junk\0opaqueType\0", 16);
+  bytes += std::string("\x00\x00\x00\x64", 4);  // 1677721600, little-endian
+  bytes += std::string(85, 'x');
+  std::ofstream(path, std::ios::binary) << bytes;
+  try {
+    wp::load_environment(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const wp::Error& e) {
+    EXPECT_EQ(std::string(e.what()), path +
+                                         ": the EXR header is corrupt (an attribute states "
+                                         "1677721600 bytes, 85 follow)");
+  }
+  std::filesystem::remove(path);
+}
+
 void expect_refused(const std::string& path, const std::string& why) {
   try {
     wp::load_environment(path);

@@ -319,6 +319,10 @@ def main():
     builtin_hdr(env_dir)
     with open(os.path.join(env_dir, "builtin.exr"), "wb") as f:
         f.write(exr(3, 2, (0.5, 1.0, 2.0)))
+    # Fuzz finding: an attribute stating 1.6 GB in a small file (OpenEXR allocated it first).
+    with open(os.path.join(env_dir, "builtin_long_attribute.exr"), "wb") as f:
+        f.write(struct.pack("<I4B", 20000630, 2, 0, 0, 0) + b"junk\0opaqueType\0"
+                + struct.pack("<I", 1677721600) + b"x" * 85)
     if assets and os.path.isdir(assets):
         n = asset_gltf(assets, gltf_dir)
         env = os.path.join(assets, "env")
