@@ -7,7 +7,8 @@ no PyPI, no renderer).
 Known answers on scenes/cornell_box.gltf and cornell_box_point.gltf (the numbers of
 scenes/README.md): triangle count, bounding box equal to the published box, the one emitter's area
 (0.13 x 0.105 m), radiance (17, 12, 4) and downward normal, the point light, the camera's position,
-direction and field of view; every wall triangle faces into the box. Node transforms (a parent
+direction and field of view; every wall triangle faces into the box; the materials' specular layer
+and the Lambertian copy (specularFactor 0, all else equal). Node transforms (a parent
 with translation, rotation and scale, a child with a mirroring matrix, whose winding must be
 reversed) on a scene written with scenes/gltf_builder.py as .glb; refusals of what the peers
 cannot represent; the PLY writer read back.
@@ -87,6 +88,19 @@ class CornellBox(unittest.TestCase):
                 _, n = ps.triangle_area(a, b, c)
                 to_centre = [centre[i] - a[i] for i in range(3)]
                 self.assertGreater(sum(n[i] * to_centre[i] for i in range(3)), 0.0, mesh["name"])
+
+    def test_specular_layer_and_lambertian_copy(self):
+        # glTF's dielectric has a specular layer (factor 1) unless KHR_materials_specular says 0.
+        self.assertTrue(all(m["specular"] == 1.0 for m in self.scene["materials"]))
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "lambertian.gltf")
+            ps.lambertian_copy(BOX, out)
+            copy = ps.load(out)
+        self.assertTrue(all(m["specular"] == 0.0 for m in copy["materials"]))
+        for a, b in zip(copy["materials"], self.scene["materials"]):
+            self.assertEqual({**a, "specular": 1.0}, b)
+        self.assertEqual(copy["meshes"], self.scene["meshes"])
+        self.assertEqual(copy["camera"], self.scene["camera"])
 
     def test_point_light(self):
         scene = ps.load(BOX_POINT)

@@ -7,15 +7,20 @@ Standard library only, so that tests/test_peers_scene.py runs without PyPI.
     scene["meshes"]        # [{"name", "material", "positions": [(x, y, z)...] in world space,
                            #   "triangles": [(i, j, k)...]}], one per triangle primitive
     scene["materials"]     # [{"name", "reflectance": (r, g, b), "emission": (r, g, b) W/(m^2 sr),
-                           #   "double_sided": bool}]
+                           #   "double_sided": bool, "specular": KHR_materials_specular factor}]
     scene["point_lights"]  # [{"name", "position": (x, y, z), "intensity": (r, g, b) W/sr}]
     scene["camera"]        # {"position", "forward", "up" (unit vectors), "yfov" (radians),
                            #  "aspect" (width / height, None when the glTF leaves it open)}
     peers_scene.write_ply(path, mesh)   # binary little-endian PLY of one mesh
+    peers_scene.lambertian_copy(path, out)  # the .gltf with specularFactor 0 on every material
 
 Only what the peers can represent exactly is accepted: triangle primitives, Lambertian materials
 (metallic 0, roughness 1, base colour factor and emission without textures, opaque), point lights,
-one perspective camera. Anything else (textures, metals, transmission, spot lights, ...) is a
+one perspective camera. A glTF dielectric (metallic 0) is Lambertian only with
+KHR_materials_specular specularFactor 0: without it, glTF (and wavepath) put a rough specular layer
+with Fresnel reflectance 0.04 (rising to 1 at grazing angles) over the diffuse one. Each material's
+"specular" is that factor (1 when absent); lambertian_copy() writes a copy of a .gltf with 0 on
+every material, the scene the peers can match. Anything else (textures, metals, transmission, spot lights, ...) is a
 ConversionError naming it, never a silent approximation. Units and conventions are wavepath's
 (scenes/README.md): metres, +Y up, linear RGB, emission = emissiveFactor x emissiveStrength as
 radiance, point light intensity x colour read as W/sr; a triangle's front is the side from which
@@ -153,7 +158,12 @@ def _material(doc, index):
     pbr = m.get("pbrMetallicRoughness", {})
     bad = [k for k in ("baseColorTexture", "metallicRoughnessTexture") if k in pbr]
     bad += [k for k in ("normalTexture", "occlusionTexture", "emissiveTexture") if k in m]
-    bad += [k for k in m.get("extensions", {}) if k != "KHR_materials_emissive_strength"]
+    ext = m.get("extensions", {})
+    bad += [k for k in ext if k not in ("KHR_materials_emissive_strength",
+                                         "KHR_materials_specular")]
+    spec = ext.get("KHR_materials_specular", {})
+    bad += [k for k in ("specularTexture", "specularColorTexture") if k in spec]
+    specular = float(spec.get("specularFactor", 1.0))
     if pbr.get("metallicFactor", 1.0) != 0.0 or pbr.get("roughnessFactor", 1.0) != 1.0:
         bad.append("metallic %s / roughness %s (needs 0 / 1)"
                    % (pbr.get("metallicFactor", 1.0), pbr.get("roughnessFactor", 1.0)))
@@ -166,7 +176,29 @@ def _material(doc, index):
         "emissiveStrength", 1.0)
     emission = tuple(float(c) * strength for c in m.get("emissiveFactor", (0.0, 0.0, 0.0)))
     return {"name": name, "reflectance": color, "emission": emission,
-            "double_sided": bool(m.get("doubleSided", False))}
+            "double_sided": bool(m.get("doubleSided", False)), "specular": specular}
+
+
+def lambertian_copy(path, out):
+    """Writes `path` (.gltf) to `out` with KHR_materials_specular specularFactor 0 on every
+    material, everything else unchanged (buffers stay embedded or next to `path`: `out` should be
+    in the same folder, or the buffers embedded)."""
+    with open(path) as f:
+        doc = json.load(f)
+    base = os.path.dirname(os.path.abspath(path))
+    for b in doc.get("buffers", []):
+        uri = b.get("uri", "")
+        if uri and not uri.startswith("data:"):
+            with open(os.path.join(base, uri), "rb") as f:
+                b["uri"] = ("data:application/octet-stream;base64,"
+                            + base64.b64encode(f.read()).decode("ascii"))
+    for m in doc.get("materials", []):
+        m.setdefault("extensions", {})["KHR_materials_specular"] = {"specularFactor": 0.0}
+    used = doc.setdefault("extensionsUsed", [])
+    if "KHR_materials_specular" not in used:
+        used.append("KHR_materials_specular")
+    with open(out, "w") as f:
+        json.dump(doc, f)
 
 
 # ---- The scene -----------------------------------------------------------------------------------
