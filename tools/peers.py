@@ -75,6 +75,9 @@ a wrong conversion also shows as relMSE that stops falling).
 
 Time to reach a relMSE target: interpolated linearly on log-log between the two runs around it;
 beyond the last run, extrapolated as relMSE ~ 1 / time from it (marked ~).
+
+The page (--out) is rewritten on every run except for what follows its line
+"<!-- notes: kept when the page is regenerated -->": hand-written notes on the figures.
 """
 
 
@@ -464,7 +467,10 @@ def fmt_t(t, mark=""):
     return "%s%.3g s" % ({"~": "~", "<=": "≤ "}.get(mark, ""), t)
 
 
-def write_doc(a, rows, checks, ref_seconds, vers, chart_name):
+NOTES_MARK = "<!-- notes: kept when the page is regenerated -->"
+
+
+def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
     by = {r: sorted((x for x in rows if x["renderer"] == r), key=lambda x: x["spp"])
           for r in a.renderers}
     cpu = platform.processor() or platform.machine()
@@ -479,10 +485,13 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name):
          "    " + cmd, "",
          "Scene `%s`, %d × %d, max depth %d scattering events, Russian roulette after %d; "
          "sweep %s samples per pixel; reference: wavepath, %d spp (%.0f s). "
-         "Machine: %s, %d cores (shared, so times are noisy); all three render on the CPU. "
+         "Machine: %s, %d cores, load average %.1f before the sweep and %.1f after it "
+         "(1 minute; anything above 0 is other work sharing the cores, which slows whichever "
+         "renderer runs then); all three render on the CPU. "
          "Versions: %s." % (os.path.relpath(a.scene, REPO), a.width, a.height, a.max_depth,
                             a.rr_depth, ", ".join(map(str, a.spp)), a.ref_spp, ref_seconds,
-                            cpu, os.cpu_count(), "; ".join("%s: %s" % kv for kv in vers.items())),
+                            cpu, os.cpu_count(), load[0], load[1],
+                            "; ".join("%s: %s" % kv for kv in vers.items())),
          "",
          "Time is the wall time of each render's whole process (start-up, kernel or JIT "
          "compilation, scene load, rendering, writing the image), measured by the script; "
@@ -535,7 +544,13 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name):
         c = checks[r]
         L.append("| %s | %d | %.4f | %.4f | %.4f | %.4f |" % (LABELS[r], c["spp"], *c["ratio"],
                                                              c["se"]))
-    L += [""]
+    notes = NOTES_MARK + "\n"
+    if os.path.exists(a.out):
+        with open(a.out) as f:
+            old = f.read()
+        if NOTES_MARK in old:
+            notes = old[old.index(NOTES_MARK):]
+    L += ["", notes]
     with open(a.out, "w") as f:
         f.write("\n".join(L))
 
@@ -567,6 +582,7 @@ def main(argv):
     n = ref.shape[0] * ref.shape[1]
     ref_mean = ref.reshape(-1, 3).mean(0)
     rows, checks = [], {}
+    load_before = os.getloadavg()[0]
     for r in a.renderers:
         run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
         for k, spp in enumerate(a.spp):
@@ -593,7 +609,8 @@ def main(argv):
     chart_path = base + "_" + os.path.splitext(os.path.basename(a.scene))[0] + ".png"
     chart(a, rows, chart_path)
     write_doc(a, rows, checks, ref_seconds, versions(a.renderers, env),
-              os.path.relpath(chart_path, os.path.dirname(os.path.abspath(a.out))))
+              os.path.relpath(chart_path, os.path.dirname(os.path.abspath(a.out))),
+              (load_before, os.getloadavg()[0]))
     log("wrote %s and %s" % (a.out, chart_path))
 
 
