@@ -9,8 +9,9 @@ Run `tools/peers.py --help` for the options. Not part of tools/test.sh: the peer
 (`mitsuba`, `bpy`, with numpy and matplotlib) into a virtual environment the script creates
 (--venv, default build/peers-venv) and then re-runs itself in. Mitsuba's LLVM variant needs a
 libLLVM shared library (DRJIT_LIBLLVM_PATH when set, else the newest
-/usr/lib/x86_64-linux-gnu/libLLVM-*.so*; Debian: libllvm15 or later); bpy 5.0 needs Python 3.11
-(--python). The converter is tools/peers_scene.py, tested by tests/test_peers_scene.py.
+/usr/lib/x86_64-linux-gnu/libLLVM-*.so*; Debian: libllvm19, with which it was run: with LLVM 15,
+Dr.Jit 1.5's kernels stop with "LLVM ERROR: Cannot select ... fminimum"); bpy 5.0 needs Python
+3.11 (--python). The converter is tools/peers_scene.py, tested by tests/test_peers_scene.py.
 """
 
 import argparse
@@ -119,7 +120,8 @@ def find_libllvm():
     path = os.environ.get("DRJIT_LIBLLVM_PATH")
     if path:
         return path
-    found = glob.glob("/usr/lib/x86_64-linux-gnu/libLLVM-*.so*") + glob.glob("/usr/lib/llvm-*/lib/libLLVM*.so*")
+    found = (glob.glob("/usr/lib/x86_64-linux-gnu/libLLVM-*.so*")
+             + glob.glob("/usr/lib/llvm-*/lib/libLLVM*.so*"))
 
     def version(p):
         m = re.search(r"libLLVM-?(\d+)", p)
@@ -562,7 +564,6 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
 
 def main(argv):
     if len(argv) >= 3 and argv[0] == "--worker":
-        sys.path.insert(0, TOOLS)
         worker_main(argv[1], argv[2])
         return
     a = parse_args(argv)
@@ -574,7 +575,7 @@ def main(argv):
     if "mitsuba" in a.renderers and a.mitsuba_variant.startswith("llvm"):
         llvm = find_libllvm()
         if llvm is None:
-            sys.exit("peers.py: error: Mitsuba's %s variant needs libLLVM (Debian: libllvm15; or "
+            sys.exit("peers.py: error: Mitsuba's %s variant needs libLLVM (Debian: libllvm19; or "
                      "set DRJIT_LIBLLVM_PATH), or use --mitsuba-variant scalar_rgb"
                      % a.mitsuba_variant)
         env["DRJIT_LIBLLVM_PATH"] = llvm
