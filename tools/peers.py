@@ -69,15 +69,14 @@ wavepath too: all three render the same purely Lambertian scene.
 Each renderer renders the sweep of --spp counts; each run is a separate process and its wall time,
 from start to the image on disk (start-up, kernel or JIT compilation, scene load included), is
 measured by this script. One unmeasured 1-spp run of each renderer first fills the caches that
-persist between processes (wavepath's kernel binary and BVH caches, Dr.Jit's kernel cache), so
-that no measured run pays a one-off compilation. relMSE is tools/accuracy_lib.py's: mean(((x - r)^2 - var_r) / (r^2 +
-0.01)) against one common reference, a wavepath render of --ref-spp samples with its variance
-image (so the reference's own noise is subtracted). The conversion is checked by the image means:
-each peer's largest run against the reference, per channel (their ratio must be 1 within noise;
-a wrong conversion also shows as relMSE that stops falling).
-
-Time to reach a relMSE target: interpolated linearly on log-log between the two runs around it;
-beyond the last run, extrapolated as relMSE ~ 1 / time from it (marked ~).
+persist between processes (wavepath's kernel binary and BVH caches, Dr.Jit's kernel cache), so that
+no measured run pays a one-off compilation. relMSE is tools/accuracy_lib.py's: mean(((x - r)^2 -
+var_r) / (r^2 + 0.01)) against one common reference, a wavepath render of --ref-spp samples with its
+variance image (so the reference's own noise is subtracted). The conversion is checked by the image
+means: each peer's largest run against the reference, per channel (their ratio must be 1 within
+noise; a wrong conversion also shows as relMSE that stops falling). Time to reach a relMSE target:
+interpolated linearly on log-log between the two runs around it; beyond the last run, extrapolated
+as relMSE ~ 1 / time from it (marked ~).
 
 The page (--out) is rewritten on every run except for what follows its line
 "<!-- notes: kept when the page is regenerated -->": hand-written notes on the figures.

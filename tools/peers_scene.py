@@ -20,12 +20,12 @@ one perspective camera. A glTF dielectric (metallic 0) is Lambertian only with
 KHR_materials_specular specularFactor 0: without it, glTF (and wavepath) put a rough specular layer
 with Fresnel reflectance 0.04 (rising to 1 at grazing angles) over the diffuse one. Each material's
 "specular" is that factor (1 when absent); lambertian_copy() writes a copy of a .gltf with 0 on
-every material, the scene the peers can match. Anything else (textures, metals, transmission, spot lights, ...) is a
-ConversionError naming it, never a silent approximation. Units and conventions are wavepath's
-(scenes/README.md): metres, +Y up, linear RGB, emission = emissiveFactor x emissiveStrength as
-radiance, point light intensity x colour read as W/sr; a triangle's front is the side from which
-its vertices run counter-clockwise, and a material that is not double-sided is invisible from the
-back (wavepath culls back faces: rays pass through them).
+every material, the scene the peers can match. Anything else (textures, metals, transmission, spot
+lights, ...) is a ConversionError naming it, never a silent approximation. Units and conventions are
+wavepath's (scenes/README.md): metres, +Y up, linear RGB, emission = emissiveFactor x
+emissiveStrength as radiance, point light intensity x colour read as W/sr; a triangle's front is the
+side from which its vertices run counter-clockwise, and a material that is not double-sided is
+invisible from the back (wavepath culls back faces: rays pass through them).
 """
 
 import base64
@@ -104,7 +104,7 @@ def _accessor(doc, buffers, index):
     return out
 
 
-# ---- Transforms (4 x 4 row-major lists) -----------------------------------------------------------
+# ---- Transforms (4 x 4 row-major lists) ----------------------------------------------------------
 
 def _matmul(a, b):
     return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
@@ -247,7 +247,8 @@ def load(path):
                 raise ConversionError("light %r: a range is not supported" % l.get("name"))
             i = float(l.get("intensity", 1.0))
             scene["point_lights"].append({
-                "name": l.get("name", "light%d" % light["light"]), "position": _point(world, (0, 0, 0)),
+                "name": l.get("name", "light%d" % light["light"]),
+                "position": _point(world, (0, 0, 0)),
                 "intensity": tuple(float(c) * i for c in l.get("color", (1.0, 1.0, 1.0)))})
         if "camera" in node:
             cameras.append((doc["cameras"][node["camera"]], world))
