@@ -1,0 +1,199 @@
+#!/usr/bin/env python3
+"""Self-test of tools/peers_scene.py, the glTF converter of tools/peers.py (stdlib unittest only;
+no PyPI, no renderer).
+
+    python3 tests/test_peers_scene.py
+
+Known answers on scenes/cornell_box.gltf and cornell_box_point.gltf (the numbers of
+scenes/README.md): triangle count, bounding box equal to the published box, the one emitter's area
+(0.13 x 0.105 m), radiance (17, 12, 4) and downward normal, the point light, the camera's position,
+direction and field of view; every wall triangle faces into the box; the materials' specular layer
+and the Lambertian copy (specularFactor 0, all else equal). Node transforms (a parent
+with translation, rotation and scale, a child with a mirroring matrix, whose winding must be
+reversed) on a scene written with scenes/gltf_builder.py as .glb; refusals of what the peers
+cannot represent; the PLY writer read back.
+"""
+
+import math
+import os
+import struct
+import sys
+import tempfile
+import unittest
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(REPO, "tools"))
+sys.path.insert(0, os.path.join(REPO, "scenes"))
+
+import gltf_builder as gb  # noqa: E402
+import peers_scene as ps  # noqa: E402
+
+BOX = os.path.join(REPO, "scenes", "cornell_box.gltf")
+BOX_POINT = os.path.join(REPO, "scenes", "cornell_box_point.gltf")
+
+
+class CornellBox(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.scene = ps.load(BOX)
+        cls.summary = ps.summary(cls.scene)
+
+    def assertClose(self, a, b, tol=1e-6):
+        self.assertEqual(len(a), len(b))
+        for x, y in zip(a, b):
+            self.assertAlmostEqual(x, y, delta=tol, msg="%s != %s" % (a, b))
+
+    def test_triangles(self):
+        # 5 walls x 2, two blocks x 5 sides x 2, the light quad x 2
+        self.assertEqual(self.summary["triangles"], 32)
+        self.assertEqual(len(self.scene["meshes"]), 8)
+
+    def test_bounding_box_is_the_published_box(self):
+        self.assertClose(self.summary["bbox_min"], (0.0, 0.0, 0.0))
+        self.assertClose(self.summary["bbox_max"], (0.556, 0.5488, 0.5592))
+
+    def test_emitter(self):
+        em = self.summary["emitters"]
+        self.assertEqual(len(em), 1)
+        self.assertAlmostEqual(em[0]["area"], 0.13 * 0.105, delta=1e-7)
+        self.assertClose(em[0]["radiance"], (17.0, 12.0, 4.0), 1e-5)
+        self.assertClose(em[0]["normal"], (0.0, -1.0, 0.0))
+        self.assertEqual(self.scene["point_lights"], [])
+
+    def test_materials(self):
+        by_name = {m["name"]: m for m in self.scene["materials"]}
+        self.assertClose(by_name["white"]["reflectance"], (0.725, 0.71, 0.68))
+        self.assertClose(by_name["red"]["reflectance"], (0.63, 0.065, 0.05))
+        self.assertClose(by_name["green"]["reflectance"], (0.14, 0.45, 0.091))
+        self.assertClose(by_name["light"]["reflectance"], (0.78, 0.78, 0.78))
+        self.assertFalse(any(m["double_sided"] for m in self.scene["materials"]))
+        self.assertFalse(any(max(m["emission"]) > 0 for n, m in by_name.items() if n != "light"))
+
+    def test_camera(self):
+        cam = self.scene["camera"]
+        self.assertClose(cam["position"], (0.278, 0.273, -0.8))
+        self.assertClose(cam["forward"], (0.0, 0.0, 1.0))
+        self.assertClose(cam["up"], (0.0, 1.0, 0.0))
+        self.assertAlmostEqual(cam["yfov"], 2 * math.atan(12.5 / 35), delta=1e-8)
+        self.assertEqual(cam["aspect"], 1.0)
+
+    def test_walls_face_into_the_box(self):
+        centre = (0.278, 0.2744, 0.2796)
+        for mesh in self.scene["meshes"]:
+            if mesh["name"] not in ("floor", "ceiling", "back_wall", "left_wall_red",
+                                    "right_wall_green"):
+                continue
+            for t in mesh["triangles"]:
+                a, b, c = (mesh["positions"][k] for k in t)
+                _, n = ps.triangle_area(a, b, c)
+                to_centre = [centre[i] - a[i] for i in range(3)]
+                self.assertGreater(sum(n[i] * to_centre[i] for i in range(3)), 0.0, mesh["name"])
+
+    def test_specular_layer_and_lambertian_copy(self):
+        # glTF's dielectric has a specular layer (factor 1) unless KHR_materials_specular says 0.
+        self.assertTrue(all(m["specular"] == 1.0 for m in self.scene["materials"]))
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "lambertian.gltf")
+            ps.lambertian_copy(BOX, out)
+            copy = ps.load(out)
+        self.assertTrue(all(m["specular"] == 0.0 for m in copy["materials"]))
+        for a, b in zip(copy["materials"], self.scene["materials"]):
+            self.assertEqual({**a, "specular": 1.0}, b)
+        self.assertEqual(copy["meshes"], self.scene["meshes"])
+        self.assertEqual(copy["camera"], self.scene["camera"])
+
+    def test_point_light(self):
+        scene = ps.load(BOX_POINT)
+        self.assertEqual(ps.summary(scene)["emitters"], [])
+        (light,) = scene["point_lights"]
+        self.assertClose(light["position"], (0.278, 0.5388, 0.2795))
+        self.assertClose(light["intensity"], (0.221063, 0.221063 * 12 / 17, 0.221063 * 4 / 17))
+
+
+class Transforms(unittest.TestCase):
+    def test_nested_nodes_and_mirroring(self):
+        b = gb.GltfBuilder()
+        white = b.material("white", base_color=(0.5, 0.5, 0.5))
+        # One triangle in the z = 0 plane, facing +Z.
+        tri = b.mesh("tri", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [0, 1, 2], white)
+        # Child: mirror x (matrix, column-major); parent: scale 2, rotate 90 deg about Y, move.
+        child = b.node("child", mesh=tri, matrix=(-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,
+                                                  0, 0, 0, 1))
+        s = math.sqrt(0.5)
+        b.node("parent", translation=(10, 0, 0), rotation=(0, s, 0, s), scale=(2, 2, 2),
+               children=[child])
+        b.node("camera", camera=b.perspective_camera(0.5, 0.01), translation=(0, 0, 5))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.glb")
+            b.write(path)
+            scene = ps.load(path)
+        (mesh,) = scene["meshes"]
+        # x -> -x, then scale 2, then Ry(90): (x, y, z) -> (z, y, -x), then +10 in x.
+        want = [(10, 0, 0), (10, 0, 2), (10, 2, 0)]
+        for p, w in zip(mesh["positions"], want):
+            for i in range(3):
+                self.assertAlmostEqual(p[i], w[i], delta=1e-6)
+        a, bb, c = (mesh["positions"][k] for k in mesh["triangles"][0])
+        _, n = ps.triangle_area(a, bb, c)
+        # The front was +Z and stays +Z under the x mirror (whose reversed winding the converter
+        # undoes); Ry(90) maps +Z to +X.
+        self.assertGreater(n[0], 0.0)
+        self.assertAlmostEqual(abs(n[0]), 2.0 * 2.0, delta=1e-5)  # |cross| = 2 x area 2
+        self.assertEqual(scene["camera"]["position"], (0.0, 0.0, 5.0))
+
+
+class Refusals(unittest.TestCase):
+    def convert(self, **material):
+        b = gb.GltfBuilder()
+        m = b.material("m", **material)
+        b.node("tri", mesh=b.mesh("tri", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [0, 1, 2], m))
+        b.node("camera", camera=b.perspective_camera(0.5, 0.01), translation=(0, 0, 5))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.gltf")
+            b.write(path)
+            return ps.load(path)
+
+    def test_lambertian_converts(self):
+        self.assertEqual(self.convert(base_color=(0.2, 0.3, 0.4))["materials"][0]["reflectance"],
+                         (0.2, 0.3, 0.4))
+
+    def test_metal_refused(self):
+        with self.assertRaisesRegex(ps.ConversionError, "not Lambertian"):
+            self.convert(metallic=1.0)
+
+    def test_transmission_refused(self):
+        with self.assertRaisesRegex(ps.ConversionError, "KHR_materials_transmission"):
+            self.convert(transmission=1.0)
+
+    def test_spot_light_refused(self):
+        b = gb.GltfBuilder()
+        b.node("spot", light=b.spot_light((1, 1, 1), 1.0, 0.1, 0.2))
+        b.node("camera", camera=b.perspective_camera(0.5, 0.01))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.gltf")
+            b.write(path)
+            with self.assertRaisesRegex(ps.ConversionError, "only point lights"):
+                ps.load(path)
+
+
+class Ply(unittest.TestCase):
+    def test_round_trip(self):
+        mesh = {"positions": [(0.0, 0.5, 1.0), (2.0, 3.0, 4.0), (5.0, 6.0, 7.25)],
+                "triangles": [(0, 1, 2), (2, 1, 0)]}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "m.ply")
+            ps.write_ply(path, mesh)
+            with open(path, "rb") as f:
+                data = f.read()
+        head, body = data.split(b"end_header\n", 1)
+        self.assertIn(b"element vertex 3", head)
+        self.assertIn(b"element face 2", head)
+        self.assertEqual(len(body), 3 * 12 + 2 * 13)
+        verts = [struct.unpack_from("<3f", body, 12 * i) for i in range(3)]
+        self.assertEqual(verts, mesh["positions"])
+        faces = [struct.unpack_from("<B3I", body, 36 + 13 * i) for i in range(2)]
+        self.assertEqual(faces, [(3, 0, 1, 2), (3, 2, 1, 0)])
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

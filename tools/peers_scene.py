@@ -1,0 +1,318 @@
+"""The scene converter of tools/peers.py: reads a glTF 2.0 scene (.gltf with embedded or external
+buffers, or .glb) into a renderer-neutral description that Mitsuba 3 and Cycles are built from.
+Standard library only, so that tests/test_peers_scene.py runs without PyPI.
+
+    import peers_scene
+    scene = peers_scene.load("scenes/cornell_box.gltf")
+    scene["meshes"]        # [{"name", "material", "positions": [(x, y, z)...] in world space,
+                           #   "triangles": [(i, j, k)...]}], one per triangle primitive
+    scene["materials"]     # [{"name", "reflectance": (r, g, b), "emission": (r, g, b) W/(m^2 sr),
+                           #   "double_sided": bool, "specular": KHR_materials_specular factor}]
+    scene["point_lights"]  # [{"name", "position": (x, y, z), "intensity": (r, g, b) W/sr}]
+    scene["camera"]        # {"position", "forward", "up" (unit vectors), "yfov" (radians),
+                           #  "aspect" (width / height, None when the glTF leaves it open)}
+    peers_scene.write_ply(path, mesh)   # binary little-endian PLY of one mesh
+    peers_scene.lambertian_copy(path, out)  # the .gltf with specularFactor 0 on every material
+
+Only what the peers can represent exactly is accepted: triangle primitives, Lambertian materials
+(metallic 0, roughness 1, base colour factor and emission without textures, opaque), point lights,
+one perspective camera. A glTF dielectric (metallic 0) is Lambertian only with
+KHR_materials_specular specularFactor 0: without it, glTF (and wavepath) put a rough specular layer
+with Fresnel reflectance 0.04 (rising to 1 at grazing angles) over the diffuse one. Each material's
+"specular" is that factor (1 when absent); lambertian_copy() writes a copy of a .gltf with 0 on
+every material, the scene the peers can match. Anything else (textures, metals, transmission, spot
+lights, ...) is a ConversionError naming it, never a silent approximation. Units and conventions are
+wavepath's (scenes/README.md): metres, +Y up, linear RGB, emission = emissiveFactor x
+emissiveStrength as radiance, point light intensity x colour read as W/sr; a triangle's front is the
+side from which its vertices run counter-clockwise, and a material that is not double-sided is
+invisible from the back (wavepath culls back faces: rays pass through them).
+"""
+
+import base64
+import json
+import math
+import os
+import struct
+
+
+class ConversionError(ValueError):
+    pass
+
+
+# ---- Reading glTF --------------------------------------------------------------------------------
+
+_COMPONENT = {5120: "b", 5121: "B", 5122: "h", 5123: "H", 5125: "I", 5126: "f"}
+_COUNT = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+
+def _read_document(path):
+    """(glTF JSON dict, list of buffer bytes)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    base = os.path.dirname(os.path.abspath(path))
+    bin_chunk = None
+    if data[:4] == b"glTF":
+        _, _, length = struct.unpack_from("<4sII", data, 0)
+        offset, doc = 12, None
+        while offset + 8 <= length:
+            chunk_len, chunk_type = struct.unpack_from("<II", data, offset)
+            chunk = data[offset + 8:offset + 8 + chunk_len]
+            if chunk_type == 0x4E4F534A:
+                doc = json.loads(chunk.decode("utf-8"))
+            elif chunk_type == 0x004E4942:
+                bin_chunk = chunk
+            offset += 8 + chunk_len
+        if doc is None:
+            raise ConversionError("%s: GLB without a JSON chunk" % path)
+    else:
+        doc = json.loads(data.decode("utf-8"))
+    buffers = []
+    for i, b in enumerate(doc.get("buffers", [])):
+        uri = b.get("uri")
+        if uri is None:
+            if bin_chunk is None:
+                raise ConversionError("%s: buffer %d has no uri and no GLB chunk" % (path, i))
+            buffers.append(bin_chunk)
+        elif uri.startswith("data:"):
+            buffers.append(base64.b64decode(uri.split(",", 1)[1]))
+        else:
+            from urllib.parse import unquote
+            with open(os.path.join(base, unquote(uri)), "rb") as f:
+                buffers.append(f.read())
+    return doc, buffers
+
+
+def _accessor(doc, buffers, index):
+    """The elements of accessor `index` as a list of tuples (or of numbers for SCALAR)."""
+    acc = doc["accessors"][index]
+    if "sparse" in acc:
+        raise ConversionError("accessor %d: sparse accessors are not supported" % index)
+    fmt = _COMPONENT[acc["componentType"]]
+    n = _COUNT[acc["type"]]
+    count = acc["count"]
+    if "bufferView" not in acc:
+        return [0 if n == 1 else (0,) * n] * count
+    view = doc["bufferViews"][acc["bufferView"]]
+    data = buffers[view["buffer"]]
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    size = struct.calcsize("<" + fmt * n)
+    stride = view.get("byteStride", size)
+    out = []
+    for k in range(count):
+        v = struct.unpack_from("<" + fmt * n, data, start + k * stride)
+        out.append(v[0] if n == 1 else v)
+    return out
+
+
+# ---- Transforms (4 x 4 row-major lists) ----------------------------------------------------------
+
+def _matmul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def node_matrix(node):
+    """A node's local transform: its `matrix` (column-major in glTF) or T * R * S."""
+    if "matrix" in node:
+        m = node["matrix"]
+        return [[m[c * 4 + r] for c in range(4)] for r in range(4)]
+    tx, ty, tz = node.get("translation", (0.0, 0.0, 0.0))
+    x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))
+    sx, sy, sz = node.get("scale", (1.0, 1.0, 1.0))
+    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    return [[r[0][0] * sx, r[0][1] * sy, r[0][2] * sz, tx],
+            [r[1][0] * sx, r[1][1] * sy, r[1][2] * sz, ty],
+            [r[2][0] * sx, r[2][1] * sy, r[2][2] * sz, tz],
+            [0.0, 0.0, 0.0, 1.0]]
+
+
+def _point(m, p):
+    return tuple(m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + m[i][3] for i in range(3))
+
+
+def _vector(m, v):
+    return tuple(m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2] for i in range(3))
+
+
+def _det3(m):
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def _normalize(v):
+    n = math.sqrt(sum(c * c for c in v))
+    if n == 0.0:
+        raise ConversionError("degenerate camera transform")
+    return tuple(c / n for c in v)
+
+
+# ---- Materials -----------------------------------------------------------------------------------
+
+def _material(doc, index):
+    if index is None:  # glTF's default material: white 1.0, metallic 1, roughness 1
+        raise ConversionError("a primitive without a material (glTF's default is metallic)")
+    m = doc["materials"][index]
+    name = m.get("name", "material%d" % index)
+    pbr = m.get("pbrMetallicRoughness", {})
+    bad = [k for k in ("baseColorTexture", "metallicRoughnessTexture") if k in pbr]
+    bad += [k for k in ("normalTexture", "occlusionTexture", "emissiveTexture") if k in m]
+    ext = m.get("extensions", {})
+    bad += [k for k in ext if k not in ("KHR_materials_emissive_strength",
+                                         "KHR_materials_specular")]
+    spec = ext.get("KHR_materials_specular", {})
+    bad += [k for k in ("specularTexture", "specularColorTexture") if k in spec]
+    specular = float(spec.get("specularFactor", 1.0))
+    if pbr.get("metallicFactor", 1.0) != 0.0 or pbr.get("roughnessFactor", 1.0) != 1.0:
+        bad.append("metallic %s / roughness %s (needs 0 / 1)"
+                   % (pbr.get("metallicFactor", 1.0), pbr.get("roughnessFactor", 1.0)))
+    if m.get("alphaMode", "OPAQUE") != "OPAQUE":
+        bad.append("alphaMode " + m["alphaMode"])
+    if bad:
+        raise ConversionError("material %r is not Lambertian: %s" % (name, ", ".join(bad)))
+    color = tuple(float(c) for c in pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3])
+    strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get(
+        "emissiveStrength", 1.0)
+    emission = tuple(float(c) * strength for c in m.get("emissiveFactor", (0.0, 0.0, 0.0)))
+    return {"name": name, "reflectance": color, "emission": emission,
+            "double_sided": bool(m.get("doubleSided", False)), "specular": specular}
+
+
+def lambertian_copy(path, out):
+    """Writes `path` (.gltf) to `out` with KHR_materials_specular specularFactor 0 on every
+    material, everything else unchanged (buffers stay embedded or next to `path`: `out` should be
+    in the same folder, or the buffers embedded)."""
+    with open(path) as f:
+        doc = json.load(f)
+    base = os.path.dirname(os.path.abspath(path))
+    for b in doc.get("buffers", []):
+        uri = b.get("uri", "")
+        if uri and not uri.startswith("data:"):
+            with open(os.path.join(base, uri), "rb") as f:
+                b["uri"] = ("data:application/octet-stream;base64,"
+                            + base64.b64encode(f.read()).decode("ascii"))
+    for m in doc.get("materials", []):
+        m.setdefault("extensions", {})["KHR_materials_specular"] = {"specularFactor": 0.0}
+    used = doc.setdefault("extensionsUsed", [])
+    if "KHR_materials_specular" not in used:
+        used.append("KHR_materials_specular")
+    with open(out, "w") as f:
+        json.dump(doc, f)
+
+
+# ---- The scene -----------------------------------------------------------------------------------
+
+def load(path):
+    """The description of the module docstring; ConversionError for what it cannot convert."""
+    doc, buffers = _read_document(path)
+    materials = [_material(doc, i) for i in range(len(doc.get("materials", [])))]
+    lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    scene = {"meshes": [], "materials": materials, "point_lights": [], "camera": None}
+    cameras = []
+
+    def visit(index, parent):
+        node = doc["nodes"][index]
+        world = _matmul(parent, node_matrix(node))
+        if "mesh" in node:
+            mesh = doc["meshes"][node["mesh"]]
+            flip = _det3(world) < 0.0  # a mirroring transform reverses the winding
+            for p, prim in enumerate(mesh["primitives"]):
+                if prim.get("mode", 4) != 4:
+                    raise ConversionError("mesh %r: primitive mode %d is not triangles"
+                                          % (mesh.get("name"), prim.get("mode")))
+                if "material" not in prim:
+                    _material(doc, None)
+                positions = [_point(world, v) for v in _accessor(doc, buffers,
+                                                                 prim["attributes"]["POSITION"])]
+                if "indices" in prim:
+                    idx = _accessor(doc, buffers, prim["indices"])
+                else:
+                    idx = list(range(len(positions)))
+                tris = [tuple(idx[k:k + 3]) for k in range(0, len(idx) - 2, 3)]
+                if flip:
+                    tris = [(a, c, b) for a, b, c in tris]
+                name = mesh.get("name", "mesh%d" % node["mesh"])
+                scene["meshes"].append({"name": name if len(mesh["primitives"]) == 1
+                                        else "%s_%d" % (name, p),
+                                        "material": prim["material"], "positions": positions,
+                                        "triangles": tris})
+        light = node.get("extensions", {}).get("KHR_lights_punctual")
+        if light is not None:
+            l = lights[light["light"]]
+            if l.get("type") != "point":
+                raise ConversionError("light %r: type %r (only point lights convert)"
+                                      % (l.get("name"), l.get("type")))
+            if "range" in l:
+                raise ConversionError("light %r: a range is not supported" % l.get("name"))
+            i = float(l.get("intensity", 1.0))
+            scene["point_lights"].append({
+                "name": l.get("name", "light%d" % light["light"]),
+                "position": _point(world, (0, 0, 0)),
+                "intensity": tuple(float(c) * i for c in l.get("color", (1.0, 1.0, 1.0)))})
+        if "camera" in node:
+            cameras.append((doc["cameras"][node["camera"]], world))
+        for child in node.get("children", []):
+            visit(child, world)
+
+    identity = [[float(i == j) for j in range(4)] for i in range(4)]
+    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        visit(root, identity)
+    if not cameras:
+        raise ConversionError("%s: no camera" % path)
+    cam, world = cameras[0]  # wavepath renders with the first camera too
+    if cam.get("type") != "perspective":
+        raise ConversionError("camera type %r: only perspective converts" % cam.get("type"))
+    scene["camera"] = {
+        "position": _point(world, (0, 0, 0)),
+        "forward": _normalize(_vector(world, (0, 0, -1))),  # glTF cameras look down -Z
+        "up": _normalize(_vector(world, (0, 1, 0))),
+        "yfov": float(cam["perspective"]["yfov"]),
+        "aspect": cam["perspective"].get("aspectRatio"),
+    }
+    return scene
+
+
+# ---- Summaries (for the test and the report) -----------------------------------------------------
+
+def triangle_area(a, b, c):
+    u = [b[i] - a[i] for i in range(3)]
+    v = [c[i] - a[i] for i in range(3)]
+    n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    return 0.5 * math.sqrt(sum(x * x for x in n)), n
+
+
+def summary(scene):
+    """{"triangles", "bbox_min", "bbox_max", "emitters": [{"name", "area", "radiance",
+    "normal"}]} (normal: the unit normal of an emitter's first triangle, its emitting side)."""
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+    tris, emitters = 0, []
+    for mesh in scene["meshes"]:
+        for p in mesh["positions"]:
+            lo = [min(lo[i], p[i]) for i in range(3)]
+            hi = [max(hi[i], p[i]) for i in range(3)]
+        tris += len(mesh["triangles"])
+        mat = scene["materials"][mesh["material"]]
+        if max(mat["emission"]) > 0.0:
+            area, normal = 0.0, None
+            for t in mesh["triangles"]:
+                a, n = triangle_area(*(mesh["positions"][k] for k in t))
+                area += a
+                normal = normal or _normalize(n)
+            emitters.append({"name": mesh["name"], "area": area, "radiance": mat["emission"],
+                             "normal": normal})
+    return {"triangles": tris, "bbox_min": tuple(lo), "bbox_max": tuple(hi), "emitters": emitters}
+
+
+def write_ply(path, mesh):
+    """One mesh as a binary little-endian PLY (float vertices, uint32 triangle lists)."""
+    head = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\n"
+            "property float y\nproperty float z\nelement face %d\n"
+            "property list uchar uint vertex_indices\nend_header\n"
+            % (len(mesh["positions"]), len(mesh["triangles"])))
+    with open(path, "wb") as f:
+        f.write(head.encode("ascii"))
+        for p in mesh["positions"]:
+            f.write(struct.pack("<3f", *p))
+        for t in mesh["triangles"]:
+            f.write(struct.pack("<B3I", 3, *t))
