@@ -6,7 +6,8 @@ in the host's order, one translation unit like host/wavefront.cpp's program_sour
 clang's OpenCL C front end, warnings as errors (-Wall -Wextra -Werror):
   nvptx64  to PTX for sm_86 (the newest clang 14 knows), linked with libclc's builtins, then
            ptxas -arch=sm_90 -v: registers, spill stores/loads and stack frame of each kernel;
-  amdgcn   to a gfx90a code object (amdhsa), linked with libclc's builtins.
+  amdgcn   to a gfx90a code object (amdhsa), linked with libclc's builtins; VGPRs, SGPRs,
+           spills and scratch per kernel from its metadata (llvm-readelf, when there).
 The variants: all features and the scene features wavepath derives for each scene (taken from
 `wavepath render --json`'s build_options, so they are exactly the host's), each at BVH width 2
 and 8, each with and without -D WP_AOV=1; identical option sets are compiled once.
@@ -17,10 +18,11 @@ into errors, unresolved builtins, spills in the traversal loop) shows here. No G
 register counts are ptxas's for clang's PTX, not the NVIDIA driver's own front end.
 
 Exit status: 0 all compiled and no spills in the traversal kernels (intersect_closest,
-trace_shadow: a spill there is paid at every BVH step); 1 a compile error or warning, or a spill
-in a traversal kernel; 2 a usage error or wavepath failing; 77 (CTest's skip) when clang lacks
-the nvptx64 or amdgcn target, or, after the clang part passed, when ptxas or libclc's nvptx64
-library is absent so registers and spills went unchecked.
+trace_shadow: a spill there is paid at every BVH step; sm_90's, and gfx90a's VGPR spills when
+known: its SGPR spills go to VGPR lanes, not memory); 1 a compile error or warning, or such a
+spill; 2 a usage error or wavepath failing; 77 (CTest's skip) when clang lacks the nvptx64 or
+amdgcn target, or, after the clang part passed, when ptxas or libclc's nvptx64 library is absent
+so registers and spills went unchecked.
 
   tools/gpu_compile.py                       everything, a table of variant x kernel
   tools/gpu_compile.py --scenes scenes/cornell_box.gltf --no-aov --markdown
@@ -183,19 +185,52 @@ def ptxas_report(ptxas, ptx):
     return kernels, run.stderr
 
 
+def find_readelf():
+    return shutil.which("llvm-readelf") or shutil.which("llvm-readelf-14")
+
+
+def amd_report(readelf, obj):
+    """{kernel: {vgprs, sgprs, vgpr_spills, sgpr_spills, scratch}} from the code object's AMDGPU
+    metadata, or None without llvm-readelf. Kernel keys are indented 4 spaces (arguments' deeper).
+    SGPR spills go to VGPR lanes, not memory; VGPR spills go to scratch memory."""
+    if not readelf:
+        return None
+    notes = subprocess.run([readelf, "--notes", obj], capture_output=True, text=True).stdout
+    kernels = []
+    for line in notes.splitlines():
+        if line.startswith("  - "):
+            kernels.append({})
+        m = re.match(r"^(?:  - |    )\.(\w+):\s+(\S+)", line)
+        if m and kernels:
+            kernels[-1][m.group(1)] = m.group(2)
+    return {k["name"]: {"vgprs": int(k["vgpr_count"]), "sgprs": int(k["sgpr_count"]),
+                        "vgpr_spills": int(k["vgpr_spill_count"]),
+                        "sgpr_spills": int(k["sgpr_spill_count"]),
+                        "scratch": int(k["private_segment_fixed_size"])}
+            for k in kernels if "name" in k}
+
+
 def markdown(results):
+    """Kernels x variants: sm_90 registers / stack, then gfx90a VGPRs / scratch when known."""
     names = [r["variant"]["label"] for r in results]
-    print("| kernel | " + " | ".join(names) + " |")
-    print("|---|" + "---:|" * len(names))
-    for k in STAGES:
-        cells = []
-        for r in results:
-            p = r["ptxas"][k]
-            cell = f"{p['regs']} / {p['stack']} B"
-            if p["spill_stores"] or p["spill_loads"]:
-                cell += f" **spills {p['spill_stores']}/{p['spill_loads']} B**"
-            cells.append(cell)
-        print(f"| {k} | " + " | ".join(cells) + " |")
+    tables = [("sm_90", "ptxas", lambda p: (p["regs"], p["stack"], "spills", p["spill_stores"]
+                                           + p["spill_loads"]))]
+    if all(r["amd"] for r in results):
+        tables.append(("gfx90a", "amd", lambda a: (a["vgprs"], a["scratch"], "SGPR spills",
+                                                   a["sgpr_spills"], "VGPR spills",
+                                                   a["vgpr_spills"])))
+    for title, key, cell in tables:
+        print(f"\n| {title} | " + " | ".join(names) + " |")
+        print("|---|" + "---:|" * len(names))
+        for k in STAGES:
+            cells = []
+            for r in results:
+                regs, stack, *spills = cell(r[key][k])
+                text = f"{regs} / {stack} B"
+                for what, count in zip(spills[::2], spills[1::2]):
+                    text += f", {what} {count}" if count else ""
+                cells.append(text)
+            print(f"| {k} | " + " | ".join(cells) + " |")
 
 
 def main():
@@ -207,7 +242,7 @@ def main():
     parser.add_argument("--quick", action="store_true", help="all features only")
     parser.add_argument("--no-aov", action="store_true", help="no WP_AOV=1 variants")
     parser.add_argument("--markdown", action="store_true",
-                        help="print the sm_90 table as markdown (kernels x variants)")
+                        help="print the tables as markdown (kernels x variants)")
     parser.add_argument("--wavepath", default=os.path.join(ROOT, "build", "wavepath"))
     parser.add_argument("-j", "--jobs", type=int, default=os.cpu_count() or 2)
     args = parser.parse_args()
@@ -237,7 +272,8 @@ def main():
                     jobs.append((v, target, pool.submit(compile_variant, clang, target, v,
                                                         program, tmp, i)))
         errors = 0
-        ptx = {}
+        ptx, amd = {}, {}
+        readelf = find_readelf()
         for v, target, job in jobs:
             out, status, stderr = job.result()
             if status != 0 or stderr.strip():
@@ -245,6 +281,8 @@ def main():
                 print(f"FAIL {target} [{v['label']}] {v['options']}\n{stderr}", file=sys.stderr)
             elif target == "nvptx64":
                 ptx[v["options"]] = out
+            else:
+                amd[v["options"]] = amd_report(readelf, out)
         print(f"gpu_compile: {len(found)} variants x {len(TARGETS)} targets, {errors} failed "
               f"(clang -Wall -Wextra -Werror; nvptx64 sm_86, amdgcn gfx90a; libclc "
               f"{'linked' if nv_lib else 'absent'})")
@@ -266,21 +304,29 @@ def main():
             if kernels is None or set(kernels) != set(STAGES):
                 print(f"FAIL ptxas [{v['label']}]\n{stderr}", file=sys.stderr)
                 return 1
-            results.append({"variant": v, "ptxas": kernels})
-            spills += [(v["label"], k) for k in TRAVERSAL
+            results.append({"variant": v, "ptxas": kernels, "amd": amd[v["options"]]})
+            spills += [(v["label"], "sm_90", k) for k in TRAVERSAL
                        if kernels[k]["spill_stores"] or kernels[k]["spill_loads"]]
+            spills += [(v["label"], "gfx90a", k) for k in TRAVERSAL
+                       if amd[v["options"]] and amd[v["options"]][k]["vgpr_spills"]]
         if args.markdown:
             markdown(results)
         else:
-            print(f"\n{'variant':<40} {'kernel':<21} {'regs':>5} {'spill st':>9} "
-                  f"{'spill ld':>9} {'stack':>6}   (ptxas -arch=sm_90, bytes)")
+            print(f"\n{'':<62}{'sm_90 (ptxas), bytes':<32}gfx90a (clang), spills in registers")
+            print(f"{'variant':<40} {'kernel':<21} {'regs':>5} {'spill st':>9} {'spill ld':>9} "
+                  f"{'stack':>6} {'vgprs':>6} {'sgprs':>6} {'v spill':>7} {'s spill':>7} "
+                  f"{'scratch':>8}")
             for r in results:
                 for k in STAGES:
                     p = r["ptxas"][k]
+                    a = r["amd"][k] if r["amd"] else dict.fromkeys(
+                        ["vgprs", "sgprs", "vgpr_spills", "sgpr_spills", "scratch"], "-")
                     print(f"{r['variant']['label']:<40} {k:<21} {p['regs']:>5} "
-                          f"{p['spill_stores']:>9} {p['spill_loads']:>9} {p['stack']:>6}")
-        for label, k in spills:
-            print(f"FAIL spills in traversal kernel {k} [{label}]", file=sys.stderr)
+                          f"{p['spill_stores']:>9} {p['spill_loads']:>9} {p['stack']:>6} "
+                          f"{a['vgprs']:>6} {a['sgprs']:>6} {a['vgpr_spills']:>7} "
+                          f"{a['sgpr_spills']:>7} {a['scratch']:>8}")
+        for label, target, k in spills:
+            print(f"FAIL spills in traversal kernel {k} for {target} [{label}]", file=sys.stderr)
         return 1 if spills else 0
 
 
