@@ -114,7 +114,7 @@ def with_width(options, width):
 
 
 def variants(args, tmp):
-    """[(name, options, scenes)] with duplicates merged."""
+    """[{label, options, scenes}]: identical option sets merged, with the scenes sharing each."""
     all_options = "-cl-std=CL1.2 -D WP_BVH_WIDTH=8"  # kernels/features.h: undefined = all on
     found = [("all", all_options, "all features")]
     scenes = []
