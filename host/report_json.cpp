@@ -101,7 +101,8 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"first_pass_seconds\":" << num(r.first_pass_seconds)
     << ",\"load_seconds\":" << num(load_seconds) << ",\"total_seconds\":" << num(total_seconds)
     << ",\"nonfinite_samples\":" << r.nonfinite_samples << ",\"rays\":" << r.rays
-    << ",\"features\":" << json_string(r.features) << ",\"wave_size\":" << r.wave_size
+    << ",\"features\":" << json_string(r.features)
+    << ",\"build_options\":" << json_string(r.build_options) << ",\"wave_size\":" << r.wave_size
     << ",\"bytes_per_path\":" << r.bytes_per_path << ",\"scene_bytes\":" << r.scene_bytes
     << ",\"scene_buffers\":" << r.scene_buffers << ",\"ranks\":" << r.ranks << ",\"outputs\":[";
   for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);

@@ -19,14 +19,14 @@
 #include "shared/film.h"
 
 /* v += (hi, lo), 128-bit values stored as two words, the low one first. */
-inline void film_add128(__global ulong* v, ulong lo, ulong hi) {
+static inline void film_add128(__global ulong* v, ulong lo, ulong hi) {
   const ulong sum = v[0] + lo;
   v[1] += hi + (sum < lo ? 1ul : 0ul); /* the carry; hi < 2^64 - 1 here, so no overflow */
   v[0] = sum;
 }
 
 /* Adds one channel's value v to the sums at `px` (the pixel's first word). */
-inline void film_add_value(__global ulong* px, uint channel, float v) {
+static inline void film_add_value(__global ulong* px, uint channel, float v) {
   const ulong a = convert_ulong_sat_rte(v * 0x1p32f);
   const ulong sq_lo = a * a, sq_hi = mul_hi(a, a); /* a^2, 128 bits */
   film_add128(px + WP_FILM_SUM(channel), a, 0ul);
@@ -38,7 +38,7 @@ inline void film_add_value(__global ulong* px, uint channel, float v) {
 
 #if WP_AOV
 /* Adds one sample's AOVs: albedo, normal + 1 and depth, one 128-bit sum each (shared/film.h). */
-inline void film_add_aovs(__global ulong* px, float4 albedo, float4 normal) {
+static inline void film_add_aovs(__global ulong* px, float4 albedo, float4 normal) {
   const float a[3] = {albedo.x, albedo.y, albedo.z}, n[3] = {normal.x, normal.y, normal.z};
   for (uint c = 0; c < 3u; ++c) {
     film_add128(px + WP_FILM_ALBEDO(c), convert_ulong_sat_rte(a[c] * 0x1p32f), 0ul);

@@ -13,7 +13,7 @@
 #include "textures.h" /* unconditionally: the source expander includes each header once */
 
 /* The material alpha of triangle `tri` at barycentrics (u, v) of its vertices 1 and 2. */
-inline float material_alpha(const SceneView* scene, uint tri, float u, float v) {
+static inline float material_alpha(const SceneView* scene, uint tri, float u, float v) {
   const uint4 tv = scene->tri_vertices[tri];
   __global const Material* m = scene->materials + tv.w;
   const float w = 1.0f - u - v;
@@ -29,11 +29,11 @@ inline float material_alpha(const SceneView* scene, uint tri, float u, float v) 
 }
 
 /* A uniform number in [0, 1) (a multiple of 2^-24) from the ray's key and the triangle. */
-inline float alpha_random(uint key, uint tri) {
+static inline float alpha_random(uint key, uint tri) {
   return (float)(wp_hash(key ^ wp_hash(tri ^ 0x9e3779b9u)) >> 8) * (1.0f / 16777216.0f);
 }
 
-inline bool alpha_passes(const SceneView* scene, uint tri, float u, float v, uint key) {
+static inline bool alpha_passes(const SceneView* scene, uint tri, float u, float v, uint key) {
   __global const Material* m = scene->materials + scene->tri_vertices[tri].w;
   const uint flags = m->flags.x;
   if (!(flags & (WP_MAT_ALPHA_MASK | WP_MAT_ALPHA_BLEND))) return true;
@@ -47,7 +47,7 @@ inline bool alpha_passes(const SceneView* scene, uint tri, float u, float v, uin
  * probability). Next-event estimation scales an emitter's radiance by it, so that light sampling
  * and BSDF sampling (whose rays see the emitter only where the traversal accepts it) estimate the
  * same light. */
-inline float alpha_coverage(const SceneView* scene, uint tri, float u, float v) {
+static inline float alpha_coverage(const SceneView* scene, uint tri, float u, float v) {
   __global const Material* m = scene->materials + scene->tri_vertices[tri].w;
   const uint flags = m->flags.x;
   if (!(flags & (WP_MAT_ALPHA_MASK | WP_MAT_ALPHA_BLEND))) return 1.0f;

@@ -81,10 +81,10 @@ typedef struct Lobes {
   float spec, trans, diff;
 } Lobes;
 
-inline bool bsdf_has_delta(const Surface* s) {
+static inline bool bsdf_has_delta(const Surface* s) {
   return sqr(s->roughness) < WP_DELTA_ALPHA;
 }
-inline bool bsdf_transmits(const Surface* s) {
+static inline bool bsdf_transmits(const Surface* s) {
 #if WP_FEATURE_TRANSMISSION
   return s->transmission > 0.0f && s->metallic < 1.0f;
 #else
@@ -92,7 +92,7 @@ inline bool bsdf_transmits(const Surface* s) {
   return false;
 #endif
 }
-inline bool bsdf_volume(const Surface* s) {
+static inline bool bsdf_volume(const Surface* s) {
 #if WP_FEATURE_VOLUME
   return (s->flags & WP_SURF_VOLUME) != 0u;
 #else
@@ -101,12 +101,12 @@ inline bool bsdf_volume(const Surface* s) {
 #endif
 }
 /* Nothing but delta lobes: light sampling cannot contribute (bsdf_eval is 0 everywhere). */
-inline bool bsdf_only_delta(const Surface* s) {
+static inline bool bsdf_only_delta(const Surface* s) {
   return bsdf_has_delta(s) && (s->metallic >= 1.0f || s->transmission >= 1.0f);
 }
 
 /* eta_t / eta_o: index of refraction across the interface relative to wo's side. */
-inline float relative_ior(const Surface* s) {
+static inline float relative_ior(const Surface* s) {
   return bsdf_volume(s) && !(s->flags & WP_SURF_FRONT) ? 1.0f / s->ior : s->ior;
 }
 
@@ -116,14 +116,14 @@ inline float relative_ior(const Surface* s) {
  * ~ alpha |eta - 1|, and its density ~ 1 / (eta - 1)^2 overflows float32.) Within 1e-3 of 1 the
  * refracted directions differ from straight by less than 1e-3 alpha radians. */
 #define WP_ETA_STRAIGHT 1e-3f
-inline bool bsdf_straight_through(const Surface* s, float eta) {
+static inline bool bsdf_straight_through(const Surface* s, float eta) {
   return !bsdf_volume(s) || fabs(eta - 1.0f) < WP_ETA_STRAIGHT;
 }
 
 /* The dielectric Fresnel reflectance (Schlick) for a wave meeting the interface at cosine cos_o on
  * its side, eta = eta_other / eta_own. From the denser side the cosine of the refracted direction
  * is used, and beyond the critical angle everything is reflected. */
-inline float fresnel_dielectric(float cos_o, float eta) {
+static inline float fresnel_dielectric(float cos_o, float eta) {
   const float f0 = sqr((eta - 1.0f) / (eta + 1.0f));
   float c = cos_o;
   if (eta < 1.0f) {
@@ -134,13 +134,13 @@ inline float fresnel_dielectric(float cos_o, float eta) {
   return f0 + (1.0f - f0) * pow5(1.0f - c);
 }
 
-inline float3 schlick3(float3 f0, float c) {
+static inline float3 schlick3(float3 f0, float c) {
   return f0 + (1.0f - f0) * pow5(1.0f - c);
 }
 
 /* The dielectric layer's reflectance at cosine cos_o: the Fresnel term scaled by the specular
  * factor. */
-inline float dielectric_reflectance(const Surface* s, float cos_o, float eta) {
+static inline float dielectric_reflectance(const Surface* s, float cos_o, float eta) {
   return s->specular * fresnel_dielectric(cos_o, eta);
 }
 
@@ -153,7 +153,7 @@ typedef struct MicrofacetWeights {
   float fd;
 } MicrofacetWeights;
 
-inline MicrofacetWeights microfacet_weights(const Surface* s, float c, float eta) {
+static inline MicrofacetWeights microfacet_weights(const Surface* s, float c, float eta) {
   MicrofacetWeights w;
   w.fd = dielectric_reflectance(s, c, eta);
   w.reflect = (1.0f - s->metallic) * w.fd + s->metallic * schlick3(s->color, c);
@@ -166,12 +166,12 @@ inline MicrofacetWeights microfacet_weights(const Surface* s, float c, float eta
  * proportional to the luminance of its two weights. Choosing per microfacet, not with F at the
  * macro normal, keeps transmission through microfacets that are below the critical angle when the
  * macro surface is beyond it (light leaving rough glass at grazing angles). */
-inline float reflect_prob(MicrofacetWeights w) {
+static inline float reflect_prob(MicrofacetWeights w) {
   const float r = luminance(w.reflect), t = luminance(w.transmit);
   return r + t > 0.0f ? r / (r + t) : 1.0f;
 }
 
-inline Lobes bsdf_lobes(const Surface* s, float cos_o, float eta) {
+static inline Lobes bsdf_lobes(const Surface* s, float cos_o, float eta) {
   const MicrofacetWeights w = microfacet_weights(s, cos_o, eta);
   const float t = bsdf_transmits(s) ? s->transmission : 0.0f;
   const float w_spec = luminance(w.reflect), w_trans = luminance(w.transmit);
@@ -183,15 +183,15 @@ inline Lobes bsdf_lobes(const Surface* s, float cos_o, float eta) {
 }
 
 /* Smith Lambda for GGX; G2 = 1 / (1 + Lambda(o) + Lambda(i)) is the height-correlated term. */
-inline float ggx_lambda(float cos_theta, float alpha) {
+static inline float ggx_lambda(float cos_theta, float alpha) {
   const float c2 = cos_theta * cos_theta;
   const float tan2 = fmax(0.0f, 1.0f - c2) / fmax(c2, 1e-12f);
   return 0.5f * (sqrt(1.0f + alpha * alpha * tan2) - 1.0f);
 }
 
 /* Reflection: f and pdf of the specular and diffuse lobes for wi above the surface. */
-inline void eval_reflection(const Surface* s, float3 wo, float3 wi, float eta, Lobes l,
-                            BsdfEval* e) {
+static inline void eval_reflection(const Surface* s, float3 wo, float3 wi, float eta, Lobes l,
+                                   BsdfEval* e) {
   const float cos_i = dot(s->ns, wi), cos_o = dot(s->ns, wo);
   const float3 h = normalize(wo + wi);
   const float v_dot_h = fmax(dot(wo, h), 0.0f);
@@ -209,8 +209,8 @@ inline void eval_reflection(const Surface* s, float3 wo, float3 wi, float eta, L
 }
 
 /* Rough transmission (wi below the surface); delta transmission has no density. */
-inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta, Lobes l,
-                              BsdfEval* e) {
+static inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta, Lobes l,
+                                     BsdfEval* e) {
   const float alpha = sqr(s->roughness), g = l.spec + l.trans;
   const float cos_o = dot(s->ns, wo), cos_i = dot(s->ns, wi);
   if (!bsdf_volume(s)) { /* thin-walled: the reflection lobe mirrored through the surface */
@@ -236,7 +236,7 @@ inline void eval_transmission(const Surface* s, float3 wo, float3 wi, float eta,
   e->pdf = g * (1.0f - reflect_prob(w)) * ggx_g1(cos_o, alpha) * o_h * d / cos_o * jacobian;
 }
 
-inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
+static inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
   BsdfEval e = {(float3)(0.0f), 0.0f};
   const float cos_i = dot(s->ns, wi), cos_o = dot(s->ns, wo);
   if (!(cos_o > 0.0f)) return e;
@@ -254,8 +254,8 @@ inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
 
 /* The delta lobes of a smooth surface: mirror reflection, or transmission (refracted with a
  * volume, straight through when thin-walled or index-matched). */
-inline BsdfSample sample_delta(const Surface* s, float3 wo, float cos_o, float eta, Lobes l,
-                               bool transmit) {
+static inline BsdfSample sample_delta(const Surface* s, float3 wo, float cos_o, float eta, Lobes l,
+                                      bool transmit) {
   BsdfSample r;
   r.delta = true, r.pdf = 0.0f, r.valid = false, r.eta_scale = 1.0f;
   if (!transmit) {
@@ -285,8 +285,8 @@ inline BsdfSample sample_delta(const Surface* s, float3 wo, float cos_o, float e
  * direction is -wo whatever the microfacet, a delta lobe. Its weight is the eta -> 1 limit of the
  * rough one, F at the sampled microfacet and G2 / G1 with wi = -wo: (1 + L) / (1 + 2 L), L the
  * Smith Lambda of wo. */
-inline BsdfSample sample_straight(const Surface* s, float3 wo, float cos_o, float eta, float o_h,
-                                  float prob) {
+static inline BsdfSample sample_straight(const Surface* s, float3 wo, float cos_o, float eta,
+                                         float o_h, float prob) {
   BsdfSample r;
   r.delta = true, r.pdf = 0.0f, r.eta_scale = eta * eta;
   r.wi = -wo;
@@ -297,7 +297,7 @@ inline BsdfSample sample_straight(const Surface* s, float3 wo, float cos_o, floa
   return r;
 }
 
-inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
+static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
   BsdfSample r;
   r.valid = false, r.delta = false, r.pdf = 0.0f, r.eta_scale = 1.0f;
   r.weight = (float3)(0.0f), r.wi = (float3)(0.0f);

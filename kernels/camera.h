@@ -8,7 +8,7 @@
 
 #include "common.h"
 
-inline void camera_ray(const Camera* cam, float2 ndc, float3* o, float3* d, float* tmin) {
+static inline void camera_ray(const Camera* cam, float2 ndc, float3* o, float3* d, float* tmin) {
   const float3 fwd = cam->forward.xyz;
   const float3 plane = ndc.x * cam->right.xyz + ndc.y * cam->up.xyz;
   const float znear = cam->position.w;

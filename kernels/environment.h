@@ -34,23 +34,23 @@
 #define WP_ENV_BELOW_ONE 0x1.fffffep-1f /* the largest float below 1 */
 
 /* World direction to the map's frame (inverse rotation), and back. */
-inline float3 env_to_map(const SceneDesc* d, float3 w) {
+static inline float3 env_to_map(const SceneDesc* d, float3 w) {
   const float c = d->env_params.y, s = d->env_params.z;
   return (float3)(c * w.x - s * w.z, w.y, s * w.x + c * w.z);
 }
-inline float3 env_from_map(const SceneDesc* d, float3 m) {
+static inline float3 env_from_map(const SceneDesc* d, float3 m) {
   const float c = d->env_params.y, s = d->env_params.z;
   return (float3)(c * m.x + s * m.z, m.y, -s * m.x + c * m.z);
 }
 
 /* Solid-angle density of a texel chosen with probability p (the product of the table
  * differences) at a point with sin(theta) = sin_theta. */
-inline float env_texel_pdf(float p, uint w, uint h, float sin_theta) {
+static inline float env_texel_pdf(float p, uint w, uint h, float sin_theta) {
   return sin_theta > 0.0f ? p * ((float)w * (float)h) / (2.0f * WP_PI * WP_PI * sin_theta) : 0.0f;
 }
 
 /* Texel (x, y) seen along map-frame direction m (any length); *sin_theta gets its sin(theta). */
-inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
+static inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
   const float r_xz = sqrt(m.x * m.x + m.z * m.z);
   const float u = fmax(0.0f, atan2(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
   const float v = atan2(r_xz, m.y) * WP_INV_PI; /* well conditioned at the poles, unlike acos */
@@ -61,7 +61,7 @@ inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
 
 /* The interval of CDF cdf[0..n] holding u: the largest i < n with cdf[i] <= u. When
  * cdf[0] <= u < cdf[n] it is non-empty: cdf[i] <= u < cdf[i+1]. */
-inline uint env_find_interval(__global const float* cdf, uint n, float u) {
+static inline uint env_find_interval(__global const float* cdf, uint n, float u) {
   uint lo = 0u, hi = n; /* cdf[lo] <= u < cdf[hi] */
   while (hi - lo > 1u) {
     const uint mid = (lo + hi) >> 1;
@@ -73,14 +73,14 @@ inline uint env_find_interval(__global const float* cdf, uint n, float u) {
   return lo;
 }
 
-inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
+static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
   const SceneDesc* d = scene->desc;
   float sin_theta;
   const uint2 t = env_texel_of(d, env_to_map(d, dir), &sin_theta);
   return scene->env_texels[t.y * d->env_width + t.x].xyz * d->env_params.x;
 }
 
-inline float env_map_pdf(const SceneView* scene, float3 dir) {
+static inline float env_map_pdf(const SceneView* scene, float3 dir) {
   const SceneDesc* d = scene->desc;
   const uint w = d->env_width;
   float sin_theta;
@@ -91,7 +91,7 @@ inline float env_map_pdf(const SceneView* scene, float3 dir) {
   return env_texel_pdf(p, w, d->env_height, sin_theta);
 }
 
-inline float3 env_map_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
+static inline float3 env_map_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
   const SceneDesc* d = scene->desc;
   const uint w = d->env_width, h = d->env_height;
   __global const float* marginal = scene->env_marginal;
@@ -116,7 +116,7 @@ inline float3 env_map_sample(const SceneView* scene, float2 u, float3* dir, floa
 
 #endif /* WP_FEATURE_ENVIRONMENT */
 
-inline float3 env_radiance(const SceneView* scene, float3 dir) {
+static inline float3 env_radiance(const SceneView* scene, float3 dir) {
 #if WP_FEATURE_ENVIRONMENT
   if (scene->desc->env_width > 0u) return env_map_radiance(scene, dir);
 #endif
@@ -126,7 +126,7 @@ inline float3 env_radiance(const SceneView* scene, float3 dir) {
 
 /* Samples a direction toward the environment; returns its radiance, *pdf is the solid-angle
  * density (0 if nothing can be sampled). */
-inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
+static inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
 #if WP_FEATURE_ENVIRONMENT
   if (scene->desc->env_width > 0u) return env_map_sample(scene, u, dir, pdf);
 #endif
@@ -139,7 +139,7 @@ inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, float* p
 }
 
 /* The solid-angle density with which env_sample produces dir. */
-inline float env_pdf(const SceneView* scene, float3 dir) {
+static inline float env_pdf(const SceneView* scene, float3 dir) {
 #if WP_FEATURE_ENVIRONMENT
   if (scene->desc->env_width > 0u) return env_map_pdf(scene, dir);
 #endif

@@ -32,7 +32,7 @@ typedef struct LightSample {
                     area light's surface toward the shading point so the ray cannot hit it */
 } LightSample;
 
-inline uint pick_light(const SceneView* scene, float u, float* pmf) {
+static inline uint pick_light(const SceneView* scene, float u, float* pmf) {
   const uint n = scene->desc->light_count;
   const float x = u * (float)n;
   const uint i = min((uint)x, n - 1u);
@@ -43,12 +43,12 @@ inline uint pick_light(const SceneView* scene, float u, float* pmf) {
 }
 
 /* KHR_lights_punctual's recommended range window, applied only when a range is given. */
-inline float range_window(float dist, float range) {
+static inline float range_window(float dist, float range) {
   if (range <= 0.0f) return 1.0f;
   return clamp(1.0f - pow(dist / range, 4.0f), 0.0f, 1.0f);
 }
 
-inline LightSample sample_punctual(__global const Light* light, float3 p) {
+static inline LightSample sample_punctual(__global const Light* light, float3 p) {
   LightSample s;
   s.delta = true;
   s.pdf = 1.0f;
@@ -77,11 +77,11 @@ inline LightSample sample_punctual(__global const Light* light, float3 p) {
 
 /* Solid-angle density of reaching point q of triangle `tv` (area-uniform sampling) from distance
  * `dist` along a direction making cos_light with the triangle's normal. */
-inline float triangle_solid_angle_pdf(float area, float dist, float cos_light) {
+static inline float triangle_solid_angle_pdf(float area, float dist, float cos_light) {
   return dist * dist / (area * fabs(cos_light));
 }
 
-inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, float2 u) {
+static inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, float2 u) {
   LightSample s;
   s.delta = false;
   s.pdf = 0.0f;
@@ -114,7 +114,7 @@ inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, f
 }
 
 /* One light sample for the shading point p. */
-inline LightSample sample_light(const SceneView* scene, float3 p, float u_pick, float2 u) {
+static inline LightSample sample_light(const SceneView* scene, float3 p, float u_pick, float2 u) {
   float pmf;
   const uint i = pick_light(scene, u_pick, &pmf);
   __global const Light* light = scene->lights + i;
@@ -135,7 +135,8 @@ inline LightSample sample_light(const SceneView* scene, float3 p, float u_pick, 
 
 /* The pdf with which NEE would have produced the direction of a ray that hit emissive triangle
  * `tri` at distance dist with cos_light between ray and triangle normal. */
-inline float triangle_light_pdf(const SceneView* scene, uint tri, float dist, float cos_light) {
+static inline float triangle_light_pdf(const SceneView* scene, uint tri, float dist,
+                                       float cos_light) {
   const uint li = scene->tri_light[tri];
   if (li == WP_NO_LIGHT) return 0.0f;
   const uint4 tv = scene->tri_vertices[tri];
@@ -146,7 +147,7 @@ inline float triangle_light_pdf(const SceneView* scene, uint tri, float dist, fl
 }
 
 /* The pdf with which NEE would have produced an escaped ray's direction. */
-inline float environment_light_pdf(const SceneView* scene, float3 dir) {
+static inline float environment_light_pdf(const SceneView* scene, float3 dir) {
   const uint li = scene->desc->env_light;
   return li == WP_NO_LIGHT ? 0.0f : scene->light_alias[li].pmf * env_pdf(scene, dir);
 }

@@ -13,17 +13,17 @@
 #include "scene.h"
 #include "textures.h" /* unconditionally: the source expander includes each header once */
 
-inline float3 interpolate3(__global const float4* a, uint4 tv, float u, float v) {
+static inline float3 interpolate3(__global const float4* a, uint4 tv, float u, float v) {
   return (1.0f - u - v) * a[tv.x].xyz + u * a[tv.y].xyz + v * a[tv.z].xyz;
 }
 
-inline float4 interpolate4(__global const float4* a, uint4 tv, float u, float v) {
+static inline float4 interpolate4(__global const float4* a, uint4 tv, float u, float v) {
   return (1.0f - u - v) * a[tv.x] + u * a[tv.y] + v * a[tv.z];
 }
 
 /* Emitted radiance of triangle `tri`'s material at barycentrics (u, v), whichever side:
  * emissive factor (x strength) x emissive texture. */
-inline float3 material_emission(const SceneView* scene, uint4 tv, float u, float v) {
+static inline float3 material_emission(const SceneView* scene, uint4 tv, float u, float v) {
   __global const Material* m = scene->materials + tv.w;
   float3 e = m->emission.xyz;
 #if WP_FEATURE_TEXTURES
@@ -42,8 +42,8 @@ inline float3 material_emission(const SceneView* scene, uint4 tv, float u, float
  * (texel * 2 - 1, x and y times the normal scale) in the basis tangent t (the interpolated vertex
  * tangent made orthogonal to n), bitangent cross(n, t) * w (glTF's convention; w the handedness)
  * and n, the interpolated vertex normal on the front side. */
-inline float3 normal_mapped(const SceneView* scene, __global const Material* m, uint4 tv, float u,
-                            float v, float4 uv, float3 n) {
+static inline float3 normal_mapped(const SceneView* scene, __global const Material* m, uint4 tv,
+                                   float u, float v, float4 uv, float3 n) {
   const float4 t4 = interpolate4(scene->tangents, tv, u, v);
   float3 t = t4.xyz - n * dot(n, t4.xyz);
   float3 b;
@@ -67,7 +67,7 @@ inline float3 normal_mapped(const SceneView* scene, __global const Material* m, 
  * reflection there). As Blender Cycles does, bend ns toward ng just enough that this reflection
  * stays a little above the surface: the result is the half vector between wo and the reflection
  * lifted to height `lift` above the tangent plane. ns is returned unchanged otherwise. */
-inline float3 keep_reflection_above(float3 ns, float3 ng, float3 wo) {
+static inline float3 keep_reflection_above(float3 ns, float3 ng, float3 wo) {
   const float3 r = 2.0f * dot(wo, ns) * ns - wo;
   const float lift = fmin(0.9f * dot(wo, ng), 0.01f);
   if (dot(r, ng) >= lift) return ns;
@@ -79,11 +79,13 @@ inline float3 keep_reflection_above(float3 ns, float3 ng, float3 wo) {
 #endif
 
 /* Base colour, metallic, roughness and transmission: factors x textures x vertex colour. */
-inline void resolve_material(const SceneView* scene, __global const Material* m, uint4 tv, float u,
-                             float v, float4 uv, Surface* s) {
+static inline void resolve_material(const SceneView* scene, __global const Material* m, uint4 tv,
+                                    float u, float v, float4 uv, Surface* s) {
   float3 color = m->base_color.xyz;
 #if WP_FEATURE_VERTEX_COLORS
   color *= interpolate3(scene->colors, tv, u, v);
+#else
+  (void)tv, (void)u, (void)v; /* only vertex colours need the triangle (-Wunused-parameter) */
 #endif
   const float4 q = m->params;
   s->metallic = q.x;
@@ -101,7 +103,7 @@ inline void resolve_material(const SceneView* scene, __global const Material* m,
   }
   if (m->textures1.x >= 0) s->transmission *= texture_sample(scene, m->textures1.x, uv).x;
 #else
-  (void)uv;
+  (void)uv, (void)scene;
 #endif
   s->color = color;
 }
@@ -109,8 +111,8 @@ inline void resolve_material(const SceneView* scene, __global const Material* m,
 /* Geometry and material at a hit of a ray with direction ray_d on triangle tv at barycentrics
  * (u, v). *front tells whether the ray hit the front (counter-clockwise) side; both normals are
  * turned to face the ray. */
-inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u, float v, float3 ray_d,
-                               bool* front) {
+static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u, float v,
+                                      float3 ray_d, bool* front) {
   __global const Material* m = scene->materials + tv.w;
   Surface s;
   const float3 p0 = scene->positions[tv.x].xyz;

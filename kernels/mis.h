@@ -17,7 +17,7 @@
 /* Written with the ratio r = p_other / p_own: p^2 / (p^2 + q^2) overflows to inf / inf = NaN for
  * pdfs above ~1.8e19 (a near-delta lobe or a tiny light seen edge-on reaches that), while
  * 1 / (1 + r^2) only ever rounds to 1 or 0. */
-inline float mis_weight(float p_own, float p_other) {
+static inline float mis_weight(float p_own, float p_other) {
   if (!(p_other > 0.0f)) return 1.0f;
   if (isinf(p_own)) return isinf(p_other) ? 0.5f : 1.0f;
   const float r = p_other / p_own;
@@ -30,7 +30,7 @@ inline float mis_weight(float p_own, float p_other) {
 
 /* Weight of emission that a BSDF-sampled ray found, given the pdf of that sample (0 after a
  * delta lobe or for a camera ray) and the pdf with which NEE would have produced it. */
-inline float mis_weight_bsdf_hit(float p_bsdf, float p_light) {
+static inline float mis_weight_bsdf_hit(float p_bsdf, float p_light) {
 #if WP_STRATEGY == WP_STRATEGY_MIS
   return p_bsdf > 0.0f ? mis_weight(p_bsdf, p_light) : 1.0f;
 #elif WP_STRATEGY == WP_STRATEGY_NEE
@@ -45,7 +45,7 @@ inline float mis_weight_bsdf_hit(float p_bsdf, float p_light) {
 
 /* Weight of a light sample with pdf p_light (0 < p_light; `delta` for a delta light) against the
  * BSDF's pdf p_bsdf of the same direction. */
-inline float mis_weight_light(float p_light, float p_bsdf, bool delta) {
+static inline float mis_weight_light(float p_light, float p_bsdf, bool delta) {
 #if WP_STRATEGY == WP_STRATEGY_MIS
   return delta ? 1.0f : mis_weight(p_light, p_bsdf);
 #else

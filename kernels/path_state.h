@@ -11,7 +11,7 @@ typedef struct Paths {
 #undef WP_PATH_FIELD
 } Paths;
 
-inline Paths paths_bind(__global uchar* base, PathLayout layout) {
+static inline Paths paths_bind(__global uchar* base, PathLayout layout) {
   Paths p;
 #define WP_PATH_FIELD(type, name, description) p.name = (__global type*)(base + layout.name);
 #include "shared/path_state.def"

@@ -20,19 +20,19 @@ typedef struct Queues {
   uint capacity;
 } Queues;
 
-inline Queues queues_bind(__global uint* slots, __global uint* counters, uint capacity) {
+static inline Queues queues_bind(__global uint* slots, __global uint* counters, uint capacity) {
   Queues q = {slots, counters, capacity};
   return q;
 }
 
 /* The slot at position `index` of queue `q`, or false when index is past its length. */
-inline bool queue_get(Queues qs, uint q, uint index, uint* slot) {
+static inline bool queue_get(Queues qs, uint q, uint index, uint* slot) {
   if (index >= qs.counters[q]) return false;
   *slot = qs.slots[q * qs.capacity + index];
   return true;
 }
 
-inline void queue_push(Queues qs, uint q, uint slot) {
+static inline void queue_push(Queues qs, uint q, uint slot) {
   const uint at = atomic_inc(&qs.counters[q]);
   qs.slots[q * qs.capacity + at] = slot;
 }
@@ -40,7 +40,7 @@ inline void queue_push(Queues qs, uint q, uint slot) {
 /* Counts a NaN or infinite value that a stage drops (it must never happen; the renderer reports
  * the count and the tests require 0). Every place that drops such a value counts it, so that no
  * failure is silent. */
-inline void count_nonfinite(Queues qs) {
+static inline void count_nonfinite(Queues qs) {
   atomic_inc(&qs.counters[WP_COUNTER_NONFINITE]);
 }
 

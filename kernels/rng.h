@@ -24,7 +24,7 @@
 #define WP_DIM_ALPHA_SHADOW 10u /* ... and of the shadow ray */
 #define WP_DIMS_PER_BOUNCE 16u
 
-inline uint wp_hash(uint x) {
+static inline uint wp_hash(uint x) {
   x ^= x >> 16;
   x *= 0x21f0aaadu;
   x ^= x >> 15;
@@ -37,23 +37,23 @@ typedef struct Rng {
   uint pixel, sample, seed, bounce;
 } Rng;
 
-inline Rng rng_make(uint pixel, uint sample, uint seed, uint bounce) {
+static inline Rng rng_make(uint pixel, uint sample, uint seed, uint bounce) {
   Rng r = {pixel, sample, seed, bounce};
   return r;
 }
 
 /* The 32 random bits of dimension `dim`. */
-inline uint rng_bits(Rng r, uint dim) {
+static inline uint rng_bits(Rng r, uint dim) {
   uint h = wp_hash(r.bounce * WP_DIMS_PER_BOUNCE + dim + wp_hash(r.seed));
   h = wp_hash(h ^ r.sample);
   return wp_hash(h ^ r.pixel);
 }
 
-inline float rng_get(Rng r, uint dim) {
+static inline float rng_get(Rng r, uint dim) {
   return (float)(rng_bits(r, dim) >> 8) * (1.0f / 16777216.0f);
 }
 
-inline float2 rng_get2(Rng r, uint dim) {
+static inline float2 rng_get2(Rng r, uint dim) {
   return (float2)(rng_get(r, dim), rng_get(r, dim + 1u));
 }
 

@@ -6,7 +6,7 @@
 #include "common.h"
 
 /* Cosine-weighted hemisphere (concentric disk mapping, then lifted): pdf = cos(theta) / pi. */
-inline float3 sample_cosine_hemisphere(float2 u) {
+static inline float3 sample_cosine_hemisphere(float2 u) {
   const float2 s = 2.0f * u - 1.0f;
   float r, phi;
   if (s.x == 0.0f && s.y == 0.0f) return (float3)(0.0f, 0.0f, 1.0f);
@@ -21,7 +21,7 @@ inline float3 sample_cosine_hemisphere(float2 u) {
   return (float3)(x, y, sqrt(fmax(0.0f, 1.0f - x * x - y * y)));
 }
 
-inline float cosine_hemisphere_pdf(float cos_theta) {
+static inline float cosine_hemisphere_pdf(float cos_theta) {
   return fmax(cos_theta, 0.0f) * WP_INV_PI;
 }
 
@@ -32,26 +32,26 @@ inline float cosine_hemisphere_pdf(float cos_theta) {
  * weights); above that, alpha^2 keeps only a few bits. Written as alpha^2 cos^2 + sin^2, with
  * sin^2 computed directly (|n x h|^2, or x^2 + y^2 in a local frame), every term is positive and
  * no bits are lost. Callers keep alpha >= WP_DELTA_ALPHA (bsdf.h), so D stays finite. */
-inline float ggx_d(float cos_h, float sin2_h, float alpha) {
+static inline float ggx_d(float cos_h, float sin2_h, float alpha) {
   const float a2 = alpha * alpha;
   const float k = a2 * cos_h * cos_h + sin2_h;
   return a2 / (WP_PI * k * k);
 }
 
 /* sin^2 of the angle between unit vectors n and h, without the cancellation of 1 - cos^2. */
-inline float sin2_between(float3 n, float3 h) {
+static inline float sin2_between(float3 n, float3 h) {
   const float3 c = cross(n, h);
   return dot(c, c);
 }
 
 /* Smith G1 for GGX. */
-inline float ggx_g1(float n_dot_v, float alpha) {
+static inline float ggx_g1(float n_dot_v, float alpha) {
   const float a2 = alpha * alpha;
   return 2.0f * n_dot_v / (n_dot_v + sqrt(a2 + (1.0f - a2) * n_dot_v * n_dot_v));
 }
 
 /* Height-correlated Smith visibility V = G2 / (4 |n.l| |n.v|) (glTF 2.0 appendix B). */
-inline float ggx_visibility(float n_dot_l, float n_dot_v, float alpha) {
+static inline float ggx_visibility(float n_dot_l, float n_dot_v, float alpha) {
   const float a2 = alpha * alpha;
   const float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
   const float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
@@ -62,7 +62,7 @@ inline float ggx_visibility(float n_dot_l, float n_dot_v, float alpha) {
 /* A microfacet normal h drawn from the distribution of normals visible from v (v.z > 0):
  * density D_v(h) = G1(v) max(0, v.h) D(h) / v.z. Method: stretch v to the hemisphere
  * configuration, sample the projected visible half-disk, unstretch (Heitz 2018). */
-inline float3 sample_ggx_visible_normal(float3 v, float alpha, float2 u) {
+static inline float3 sample_ggx_visible_normal(float3 v, float alpha, float2 u) {
   const float3 vh = normalize((float3)(alpha * v.x, alpha * v.y, v.z));
   const float len2 = vh.x * vh.x + vh.y * vh.y;
   const float3 t1 =
@@ -80,7 +80,7 @@ inline float3 sample_ggx_visible_normal(float3 v, float alpha, float2 u) {
 /* Density of the reflected direction l = reflect(v, h) when h is sampled as above:
  * D_v(h) / (4 v.h) = G1(v) D(h) / (4 v.z). h's cosine and squared sine to the normal as in
  * ggx_d. */
-inline float ggx_reflection_pdf(float n_dot_v, float n_dot_h, float sin2_h, float alpha) {
+static inline float ggx_reflection_pdf(float n_dot_v, float n_dot_h, float sin2_h, float alpha) {
   return ggx_g1(n_dot_v, alpha) * ggx_d(n_dot_h, sin2_h, alpha) / (4.0f * n_dot_v);
 }
 

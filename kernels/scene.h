@@ -32,11 +32,13 @@ typedef struct SceneView {
       __global const uchar *scene3, __global const uchar *scene4, __global const uchar *scene5, \
       __global const uchar *scene6, __global const uchar *scene7, SceneDesc scene_desc
 
-/* Declares `view`, the SceneView of WP_SCENE_PARAMS. */
+/* Declares `view`, the SceneView of WP_SCENE_PARAMS. Stages that never read the scene bind it
+ * too (one argument list for all); the (void) keeps clang's -Wunused-variable quiet for them. */
 #define WP_SCENE_BIND(view)                                                                  \
   __global const uchar* view##_buffers[WP_SCENE_BUFFERS] = {scene0, scene1, scene2, scene3,  \
                                                             scene4, scene5, scene6, scene7}; \
-  const SceneView view = scene_bind(view##_buffers, &scene_desc)
+  const SceneView view = scene_bind(view##_buffers, &scene_desc);                            \
+  (void)view
 
 #ifndef WP_SCENE_BUFFER_MAP
 #define WP_SCENE_BUFFER_MAP 0 /* every array in buffer 0 */
@@ -47,15 +49,15 @@ typedef struct SceneView {
   ((uint)(((ulong)(WP_SCENE_BUFFER_MAP) >> (WP_SCENE_BUFFER_BITS * (i))) & (WP_SCENE_BUFFERS - 1)))
 
 /* The first byte of the array that starts `offset` 64-byte units into `buffers[buffer]`. */
-inline __global const uchar* scene_array(__global const uchar* const* buffers, uint buffer,
-                                         uint offset) {
+static inline __global const uchar* scene_array(__global const uchar* const* buffers, uint buffer,
+                                                uint offset) {
   return buffers[buffer] + (ulong)offset * WP_SCENE_ALIGN;
 }
 
 #define WP_SCENE_ARRAY(type, i, offset) \
   ((__global const type*)scene_array(b, WP_SCENE_BUFFER_OF(i), d->offset))
 
-inline SceneView scene_bind(__global const uchar* const* b, const SceneDesc* d) {
+static inline SceneView scene_bind(__global const uchar* const* b, const SceneDesc* d) {
   SceneView s;
   s.nodes = WP_SCENE_ARRAY(BvhNode, 0, bvh_nodes);
   s.tris = WP_SCENE_ARRAY(IsectTri, 1, isect_tris);

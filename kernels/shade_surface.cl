@@ -15,7 +15,7 @@
  * not delta lobes alone, so that mirrors and smooth glass show what they reflect or let through,
  * as OIDN and OptiX want their albedo and normal inputs; or the background, for a path that leaves
  * the scene first. The depth (w) is set apart, by the camera ray. */
-inline void aov_record(Paths paths, uint slot, float3 albedo, float3 normal) {
+static inline void aov_record(Paths paths, uint slot, float3 albedo, float3 normal) {
   if (paths.aov_normal[slot].w != 0.0f) return;
   paths.aov_albedo[slot] = (float4)(albedo, paths.aov_albedo[slot].w);
   paths.aov_normal[slot] = (float4)(normal, 1.0f);

@@ -21,7 +21,7 @@
   const Queues queues = queues_bind(queue_slots, queue_counters, path_layout.capacity)
 
 /* The random numbers of the path in `slot` at its current bounce. */
-inline Rng path_rng(Paths paths, uint slot, Launch launch) {
+static inline Rng path_rng(Paths paths, uint slot, Launch launch) {
   const uint4 info = paths.info[slot];
   return rng_make(info.x, launch.sample, launch.seed, info.y);
 }

@@ -5,7 +5,7 @@
 #include "bsdf.h"
 #include "path_state.h"
 
-inline void surface_store(Paths paths, uint slot, const Surface* s) {
+static inline void surface_store(Paths paths, uint slot, const Surface* s) {
   paths.surf_p[slot] = (float4)(s->p, s->p_scale);
   paths.surf_ng[slot] = (float4)(s->ng, s->specular);
   paths.surf_ns[slot] = (float4)(s->ns, 0.0f);
@@ -13,7 +13,7 @@ inline void surface_store(Paths paths, uint slot, const Surface* s) {
   paths.surf_params[slot] = (float4)(s->roughness, s->ior, s->transmission, as_float(s->flags));
 }
 
-inline Surface surface_load(Paths paths, uint slot) {
+static inline Surface surface_load(Paths paths, uint slot) {
   Surface s;
   const float4 p = paths.surf_p[slot];
   s.p = p.xyz;
@@ -40,7 +40,7 @@ inline Surface surface_load(Paths paths, uint slot) {
  * finds t = 0 (or -1e-8) and passes through it, leaking light into closed rooms
  * (scenes/failure/closed_box). The pulled-back point is on the path's free side of every surface
  * the path did not cross. A refracted ray leaves on the far side, where there is no such point. */
-inline float3 surface_spawn(const Surface* s, float3 d_in, float t_in, float3 wi) {
+static inline float3 surface_spawn(const Surface* s, float3 d_in, float t_in, float3 wi) {
   if (dot(wi, s->ng) > 0.0f) /* ng faces the incoming ray */
     return offset_origin(s->p - d_in * fmin(offset_distance(s->p_scale), 0.5f * t_in), s->ng,
                          s->p_scale);

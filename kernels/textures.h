@@ -19,12 +19,13 @@
 #include "srgb_lut.h"
 
 /* The sRGB EOTF (IEC 61966-2-1): encoded value c in [0, 1] to linear. */
-inline float srgb_to_linear(float c) {
+static inline float srgb_to_linear(float c) {
   return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
 }
 
 /* Texel (x, y) of `img` (both in range) as RGBA in [0, 1], decoded to linear when srgb. */
-inline float4 texel_fetch(__global const uint* texels, TextureImage img, int x, int y, bool srgb) {
+static inline float4 texel_fetch(__global const uint* texels, TextureImage img, int x, int y,
+                                 bool srgb) {
   const uint p = texels[img.offset + (uint)y * img.width + (uint)x];
   float4 c = (float4)((float)(p & 0xffu), (float)((p >> 8) & 0xffu), (float)((p >> 16) & 0xffu),
                       (float)(p >> 24)) *
@@ -36,7 +37,7 @@ inline float4 texel_fetch(__global const uint* texels, TextureImage img, int x, 
 }
 
 /* Texel index i (any integer) wrapped into [0, n) by WP_WRAP_* `mode`. */
-inline int wrap_texel(int i, int n, uint mode) {
+static inline int wrap_texel(int i, int n, uint mode) {
   if (mode == WP_WRAP_CLAMP) return clamp(i, 0, n - 1);
   if (mode == WP_WRAP_MIRROR) {
     int m = i % (2 * n);
@@ -50,14 +51,14 @@ inline int wrap_texel(int i, int n, uint mode) {
 /* A texture coordinate moved by whole wrap periods (1 for REPEAT, 2 for MIRRORED_REPEAT) into a
  * small range, or clamped just outside [0, 1] for CLAMP_TO_EDGE, so that texel indices computed
  * from it fit an int; wrap_texel then gives the same texels as for the original coordinate. */
-inline float wrap_reduce(float u, uint mode) {
+static inline float wrap_reduce(float u, uint mode) {
   if (mode == WP_WRAP_CLAMP) return clamp(u, -1.0f, 2.0f);
   if (mode == WP_WRAP_MIRROR) return u - 2.0f * floor(0.5f * u);
   return u - floor(u);
 }
 
 /* Texture `ref` at the vertex texture coordinates uv01 (xy: TEXCOORD_0, zw: TEXCOORD_1). */
-inline float4 texture_sample(const SceneView* scene, int ref, float4 uv01) {
+static inline float4 texture_sample(const SceneView* scene, int ref, float4 uv01) {
   __global const TextureRef* t = scene->textures + ref;
   const uint4 meta = t->meta;
   const TextureImage img = scene->images[meta.x];

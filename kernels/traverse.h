@@ -35,11 +35,11 @@ typedef struct TraceHit {
   uint tri; /* scene triangle index; valid when t < the ray's tmax */
 } TraceHit;
 
-inline float safe_rcp(float d) {
+static inline float safe_rcp(float d) {
   return 1.0f / (fabs(d) > 1e-20f ? d : copysign(1e-20f, d));
 }
 
-inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key) {
+static inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key) {
   TraceRay r;
   r.ox = o.x, r.oy = o.y, r.oz = o.z;
   r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
@@ -65,8 +65,8 @@ inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key) {
 
 /* Slab test of one box; returns the entry distance, or INFINITY when the box is missed within
  * [tmin, tmax]. */
-inline float box_entry(const TraceRay* r, float lox, float hix, float loy, float hiy, float loz,
-                       float hiz, float tmax) {
+static inline float box_entry(const TraceRay* r, float lox, float hix, float loy, float hiy,
+                              float loz, float hiz, float tmax) {
   const float tx0 = (lox - r->ox) * r->ix, tx1 = (hix - r->ox) * r->ix;
   const float ty0 = (loy - r->oy) * r->iy, ty1 = (hiy - r->oy) * r->iy;
   const float tz0 = (loz - r->oz) * r->iz, tz1 = (hiz - r->oz) * r->iz;
@@ -76,8 +76,8 @@ inline float box_entry(const TraceRay* r, float lox, float hix, float loy, float
 }
 
 /* The watertight test against one stored triangle. On a hit closer than hit->t, updates *hit. */
-inline bool triangle_test(const SceneView* scene, const TraceRay* r, __global const IsectTri* tri,
-                          TraceHit* hit) {
+static inline bool triangle_test(const SceneView* scene, const TraceRay* r,
+                                 __global const IsectTri* tri, TraceHit* hit) {
   __global const float* v0 = (__global const float*)&tri->v0;
   __global const float* v1 = (__global const float*)&tri->v1;
   __global const float* v2 = (__global const float*)&tri->v2;
@@ -111,8 +111,8 @@ inline bool triangle_test(const SceneView* scene, const TraceRay* r, __global co
 }
 
 /* Intersects the leaf [first, first + count); with `any`, stops at the first hit. */
-inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref, int count, TraceHit* hit,
-                      bool any) {
+static inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref, int count,
+                             TraceHit* hit, bool any) {
   bool found = false;
   __global const IsectTri* tri = scene->tris + ~ref;
   for (int i = 0; i < count; ++i) {
@@ -133,8 +133,8 @@ inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref, int co
 #else
 /* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
  * hit; the hit record holds the closest one found. */
-inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
-                      bool any) {
+static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
+                             bool any) {
   __global const BvhNode* nodes = scene->nodes;
   int stack[WP_BVH_STACK_SIZE];
   int sp = 0;

@@ -12,8 +12,8 @@
 
 /* The watertight test (bvh/traverse_common.h) on the 4 lanes of a block; updates *hit with the
  * closest lane that is closer. */
-inline bool block_test(const SceneView* scene, const TraceRay* r, __global const TriBlock4* b,
-                       TraceHit* hit) {
+static inline bool block_test(const SceneView* scene, const TraceRay* r,
+                              __global const TriBlock4* b, TraceHit* hit) {
   const float4 az = b->v0[r->kz] - r->o_kz, bz = b->v1[r->kz] - r->o_kz,
                cz = b->v2[r->kz] - r->o_kz;
   const float4 ax = (b->v0[r->kx] - r->o_kx) - r->sx * az;
@@ -61,8 +61,8 @@ inline bool block_test(const SceneView* scene, const TraceRay* r, __global const
   return found;
 }
 
-inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref, TraceHit* hit,
-                       bool any_hit) {
+static inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref, TraceHit* hit,
+                              bool any_hit) {
   const int c = ~ref;
   __global const TriBlock4* b = (__global const TriBlock4*)scene->tris + (c >> 2);
   const int blocks = (c & 3) + 1;
@@ -77,8 +77,8 @@ inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref, Trace
 }
 
 /* Closest hit (any_hit = false) or any hit (true) in (tmin, tmax). */
-inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
-                      bool any_hit) {
+static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
+                             bool any_hit) {
   __global const BvhNode8* nodes = (__global const BvhNode8*)scene->nodes;
   int stack_node[WP_BVH8_STACK_SIZE];
   float stack_t[WP_BVH8_STACK_SIZE];

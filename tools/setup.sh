@@ -11,7 +11,7 @@ PACKAGES=(
   opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd
   libembree-dev libtinygltf-dev libglm-dev libopenexr-dev libstb-dev libcli11-dev
   libgtest-dev libbenchmark-dev oclgrind
-  clang libclang-rt-14-dev nlohmann-json3-dev
+  clang libclang-rt-14-dev libclc-14 nlohmann-json3-dev
   libopenmpi-dev openmpi-bin
 )
 
