@@ -203,6 +203,38 @@ void check_exr_window(const std::string& path, long long w, long long h, std::ui
                 " bytes: the EXR header is corrupt");
 }
 
+// The bytes a value of EXR attribute type `type` takes (OpenEXR reads that many whatever the
+// stated size), or 0 for types of variable size (strings, channel lists, previews, unknown ones).
+std::size_t exr_fixed_size(const std::string& type) {
+  static const std::pair<const char*, std::size_t> kSizes[] = {{"box2i", 16},
+                                                               {"box2f", 16},
+                                                               {"compression", 1},
+                                                               {"lineOrder", 1},
+                                                               {"envmap", 1},
+                                                               {"int", 4},
+                                                               {"float", 4},
+                                                               {"double", 8},
+                                                               {"v2i", 8},
+                                                               {"v2f", 8},
+                                                               {"v2d", 16},
+                                                               {"v3i", 12},
+                                                               {"v3f", 12},
+                                                               {"v3d", 24},
+                                                               {"m33f", 36},
+                                                               {"m33d", 72},
+                                                               {"m44f", 64},
+                                                               {"m44d", 128},
+                                                               {"rational", 8},
+                                                               {"timecode", 8},
+                                                               {"keycode", 28},
+                                                               {"tiledesc", 9},
+                                                               {"chromaticities", 32},
+                                                               {"deepImageState", 1}};
+  for (const auto& [name, bytes] : kSizes)
+    if (type == name) return bytes;
+  return 0;
+}
+
 // The attributes of an EXR file's header(s), walked before OpenEXR reads them: each attribute's
 // size must fit in the bytes that follow it. OpenEXR allocates an unknown ("opaque") attribute's
 // stated size before reading it, so a 202-byte file stating 1.6 GB made it allocate that much
@@ -233,7 +265,9 @@ void check_exr_attributes(const std::string& path) {
       empty = false;
       const bool window =
           std::strcmp(reinterpret_cast<const char*>(&b[name_at]), "dataWindow") == 0;
+      const std::size_t type_at = at;
       text("attribute type");
+      const std::string type(reinterpret_cast<const char*>(&b[type_at]));
       if (b.size() - at < 4) throw fail("truncated attribute size");
       const std::uint32_t size = std::uint32_t(b[at]) | std::uint32_t(b[at + 1]) << 8 |
                                  std::uint32_t(b[at + 2]) << 16 | std::uint32_t(b[at + 3]) << 24;
@@ -241,6 +275,22 @@ void check_exr_attributes(const std::string& path) {
       if (size > b.size() - at)
         throw fail("an attribute states " + std::to_string(size) + " bytes, " +
                    std::to_string(b.size() - at) + " follow");
+      // OpenEXR reads a value of a known type by its type, not by the stated size (fuzzing: a
+      // channel list one byte longer than stated put OpenEXR, but not this walk, on an attribute
+      // stating 1.9 GB). Valid files state exactly what their types take; anything else is
+      // refused here, so that this walk and OpenEXR see the same attributes.
+      if (const std::size_t fixed = exr_fixed_size(type); fixed && fixed != size)
+        throw fail("a " + type + " attribute of " + std::to_string(size) + " bytes, not " +
+                   std::to_string(fixed));
+      if (type == "chlist") {  // entries: a name, then 16 bytes; an empty name ends the list
+        std::size_t c = at;
+        const std::size_t end = at + size;
+        while (c < end && b[c] != 0) {
+          while (c < end && b[c] != 0) ++c;
+          c += 1 + 16;
+        }
+        if (c + 1 != end) throw fail("a channel list that does not end where its size says");
+      }
       if (window && size == 16) {  // box2i: xMin, yMin, xMax, yMax
         std::int32_t v[4];
         for (int i = 0; i < 4; ++i)

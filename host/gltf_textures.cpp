@@ -2,6 +2,7 @@
 
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -99,10 +100,14 @@ void check_png_chunks(const unsigned char* bytes, std::size_t size, const std::s
     at += 12 + length;
   }
   const double filtered = rows * (1.0 + std::ceil(row_bits / 8.0));
-  if (filtered > 1032.0 * idat + 8.0 * rows + 65536.0)
-    throw Error(what + ": PNG image data of " + std::to_string(std::size_t(idat)) +
-                " bytes cannot hold its " + std::to_string(std::size_t(filtered)) +
-                " bytes of rows");
+  if (filtered > 1032.0 * idat + 8.0 * rows + 65536.0) {
+    // As text from the doubles: the rows' size may exceed any integer type (fuzzing: 3e19).
+    char message[128];
+    std::snprintf(message, sizeof message,
+                  "PNG image data of %.0f bytes cannot hold its %.0f bytes of rows", idat,
+                  filtered);
+    throw Error(what + ": " + message);
+  }
 }
 
 }  // namespace

@@ -236,6 +236,23 @@ TEST(EnvironmentLoad, ExrAttributeLongerThanTheFileIsAnError) {
                                          ": the EXR header is corrupt (an attribute states "
                                          "1677721600 bytes, 85 follow)");
   }
+  // OpenEXR reads known types by their type, not their stated size: a channel list longer than
+  // stated (fuzzing: then OpenEXR met a 1.9 GB attribute the walk never saw) and a fixed-size
+  // value of another size are refused, so the walk and OpenEXR agree.
+  const std::string head("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  for (const auto& [attribute, cause] : std::vector<std::pair<std::string, std::string>>{
+           {std::string("channels\0chlist\0\x12\0\0\0R\0", 21) + std::string(17, '\0'),
+            "a channel list that does not end where its size says"},
+           {std::string("compression\0compression\0\x02\0\0\0\0\0", 30),
+            "a compression attribute of 2 bytes, not 1"}}) {
+    std::ofstream(path, std::ios::binary) << head + attribute + std::string(64, '\0');
+    try {
+      wp::load_environment(path);
+      ADD_FAILURE() << cause << ": accepted";
+    } catch (const wp::Error& e) {
+      EXPECT_NE(std::string(e.what()).find(cause), std::string::npos) << e.what();
+    }
+  }
   std::filesystem::remove(path);
 }
 
