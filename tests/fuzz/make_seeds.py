@@ -149,6 +149,16 @@ def triangle_scene(variant):
         doc["textures"] = [{"source": 0}]
         doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
         return doc, buf
+    elif variant == "png_rows_overflow":
+        # IHDR stating 4294967295 x 4294967295: the rows' size (7e19 bytes) exceeds any integer;
+        # the refusal's message once converted it to one (UBSan, a fuzz finding).
+        doc, buf = triangle_scene("plain")
+        png = bytearray(png_rgba(2, 2, (9, 8, 7, 255)))
+        png[16:24] = struct.pack(">II", 0xFFFFFFFF, 0xFFFFFFFF)
+        doc["images"] = [{"uri": data_uri("image/png", bytes(png))}]
+        doc["textures"] = [{"source": 0}]
+        doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+        return doc, buf
     elif variant == "png_empty_idat":
         doc, buf = triangle_scene("plain")
         doc["images"] = [{"uri": data_uri("image/png", png_rgba(2, 2, (9, 8, 7, 255), True))}]
@@ -167,7 +177,8 @@ def triangle_scene(variant):
 
 def builtin_gltf(out):
     for variant in ("plain", "textured", "image_in_buffer", "extensions", "modes",
-                    "sparse_bad_type", "png_empty_idat", "png_idat_too_long"):
+                    "sparse_bad_type", "png_empty_idat", "png_idat_too_long",
+                    "png_rows_overflow"):
         doc, buf = triangle_scene(variant)
         with open(os.path.join(out, "builtin_%s.glb" % variant), "wb") as f:
             f.write(glb(doc, buf))
