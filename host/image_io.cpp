@@ -25,14 +25,14 @@
 
 namespace wp {
 
-namespace {
-
 std::string extension_of(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
+
+namespace {
 
 // Adds img's R, G, B as channels `prefix`R/G/B to the header and the frame buffer.
 void add_rgb(Imf::Header& header, Imf::FrameBuffer& fb, const ImageRgb& img,

@@ -24,6 +24,9 @@ struct PngOptions {
   Tonemap tonemap = Tonemap::kAces;
 };
 
+// The file name's extension, lower case, with its dot (".exr"), or "".
+std::string extension_of(const std::string& path);
+
 // One output file: `write` writes its content to the path it is given (a temporary name beside
 // `path`), throwing on failure.
 struct OutputFile {

@@ -80,11 +80,7 @@ int list_devices() {
   return 0;
 }
 
-std::string extension_of(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
+using wp::extension_of;
 
 bool is_film(const std::string& path) {
   return extension_of(path) == ".wpfilm";
@@ -139,6 +135,21 @@ void apply_samples(const CLI::App& render, const CliOptions& cli, wp::RenderSett
   settings.spp = end - begin;
 }
 
+const std::vector<std::string> kAovNames = {"albedo", "normal", "depth"};
+
+// The PNG output's options, the same for render and merge.
+void add_png_options(CLI::App* app, CliOptions& cli) {
+  app->add_option("--tonemap", cli.tonemap, "PNG tonemap: aces or clamp")
+      ->check(CLI::IsMember({"aces", "clamp"}))
+      ->capture_default_str();
+  app->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
+}
+
+void check_exposure(const CliOptions& cli) {
+  if (!std::isfinite(cli.exposure) || std::abs(cli.exposure) > 64.0f)
+    throw wp::Error("--exposure must be a finite number of stops between -64 and 64");
+}
+
 // Ranges CLI11 cannot express and wp::validate (render.h) does not cover: these are the command
 // line's own, so they are checked here, before anything is loaded.
 void check_options(const CLI::App& render, const CliOptions& cli,
@@ -149,8 +160,7 @@ void check_options(const CLI::App& render, const CliOptions& cli,
   // -1 is the internal "not given" value; a user who types it means a camera that cannot exist.
   check(render.count("--camera") == 0 || settings.camera >= 0,
         "--camera " + std::to_string(settings.camera) + ": camera indices start at 0");
-  check(std::isfinite(cli.exposure) && std::abs(cli.exposure) <= 64.0f,
-        "--exposure must be a finite number of stops between -64 and 64");
+  check_exposure(cli);
   check(settings.spp <= (1 << 20), "--spp must be at most 1048576");
   check(settings.wave_size <= (std::size_t{1} << 24), "--wave-size must be at most 16777216");
   check(settings.local_size <= 1024, "--local-size must be at most 1024");
@@ -614,10 +624,7 @@ int main(int argc, char** argv) {
                    "Kernel specialisation: `scene` (only what the scene uses) or `all`")
       ->check(CLI::IsMember({"scene", "all"}))
       ->capture_default_str();
-  render->add_option("--tonemap", cli.tonemap, "PNG tonemap: aces or clamp")
-      ->check(CLI::IsMember({"aces", "clamp"}))
-      ->capture_default_str();
-  render->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
+  add_png_options(render, cli);
   render->add_flag("--spatial-splits", cli.spatial_splits,
                    "Build the BVH with spatial splits (slower build, faster traversal)");
   render->add_option("--wave-size", settings.wave_size, "Path slots per wave [default: auto]");
@@ -643,7 +650,7 @@ int main(int argc, char** argv) {
                    "first hit, 0 for a miss): EXR layers albedo.R/G/B, normal.X/Y/Z, depth.Z; "
                    "X.albedo.pfm etc. beside X.pfm; kept in .wpfilm outputs")
       ->delimiter(',')
-      ->check(CLI::IsMember({"albedo", "normal", "depth"}));
+      ->check(CLI::IsMember(kAovNames));
   render->add_flag("--profile", settings.profile, "Time each kernel (adds stage times to --json)");
   render->add_flag("--json", cli.json,
                    "Print a JSON summary as the last line of stdout (spp, sample_begin, "
@@ -664,17 +671,14 @@ int main(int argc, char** argv) {
                    "Output file(s): .exr, .png, .pfm (the merged image) and/or .wpfilm (the merged "
                    "film)")
       ->required();
-  merge->add_option("--tonemap", cli.tonemap, "PNG tonemap: aces or clamp")
-      ->check(CLI::IsMember({"aces", "clamp"}))
-      ->capture_default_str();
-  merge->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
+  add_png_options(merge, cli);
   merge->add_flag("--variance", cli.variance,
                   "Also write the variance of each pixel's estimate (as render --variance)");
   merge
       ->add_option("--aov", cli.aovs,
                    "Also write these AOVs, which the films must hold (as render --aov)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"albedo", "normal", "depth"}));
+      ->check(CLI::IsMember(kAovNames));
   merge->add_flag("--json", cli.json,
                   "Print a JSON summary (parts, spp, sample_begin, sample_end, width, height, "
                   "device, nonfinite_samples, outputs) as the last line of stdout");
@@ -690,8 +694,7 @@ int main(int argc, char** argv) {
   try {
     if (devices->parsed()) return list_devices();
     if (merge->parsed()) {
-      if (!std::isfinite(cli.exposure) || std::abs(cli.exposure) > 64.0f)
-        throw wp::Error("--exposure must be a finite number of stops between -64 and 64");
+      check_exposure(cli);
       return merge_command(cli);
     }
     return render_command(*render, cli, settings, program_start);
