@@ -43,6 +43,7 @@ struct CliOptions {
   std::string strategy = "mis";
   std::string heuristic = "power";
   std::string light_select = "power";
+  std::string sampler = "sobol";
   bool no_rr = false;
   bool variance = false;
   bool no_bvh_cache = false;
@@ -296,6 +297,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
       cli.heuristic == "balance" ? wp::MisHeuristic::kBalance : wp::MisHeuristic::kPower;
   settings.light_select =
       cli.light_select == "uniform" ? wp::LightSelect::kUniform : wp::LightSelect::kPower;
+  settings.sampler = cli.sampler == "independent" ? wp::Sampler::kIndependent : wp::Sampler::kSobol;
   if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);
   if (!cli.env.empty())
@@ -606,6 +608,12 @@ int main(int argc, char** argv) {
       ->add_option("--light-select", cli.light_select,
                    "How NEE picks a light: power (proportional to estimated power) or uniform")
       ->check(CLI::IsMember({"power", "uniform"}))
+      ->capture_default_str();
+  render
+      ->add_option("--sampler", cli.sampler,
+                   "Sample pattern: sobol (Owen-scrambled Sobol' points per pixel: less error "
+                   "for the same samples) or independent (a hash per random number)")
+      ->check(CLI::IsMember({"sobol", "independent"}))
       ->capture_default_str();
   render->add_option("--max-depth", settings.max_depth, "Most scattering events per path")
       ->capture_default_str();

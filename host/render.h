@@ -108,9 +108,9 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
 // with films of the same render (host/film.h). ';'-separated name=value fields: the scene's digest
 // (Scene::digest), the environment map's (FNV-1a 64 of its texels) or none, width, height,
 // max_depth, rr_depth, seed, background, env_intensity, env_rotation, strategy, mis_heuristic,
-// light_select, camera, features, bvh_width, spatial_splits and the kernels' source digest. Not
-// in it, as they do not change the image: the sample range, wave and work-group sizes, the scene
-// buffer limit, the device, caching, outputs and reporting.
+// light_select, sampler, camera, features, bvh_width, spatial_splits and the kernels' source
+// digest. Not in it, as they do not change the image: the sample range, wave and work-group sizes,
+// the scene buffer limit, the device, caching, outputs and reporting.
 std::string render_key(const Scene& scene, const RenderSettings& settings, int bvh_width,
                        bool spatial_splits, std::uint64_t kernel_digest);
 

@@ -21,6 +21,7 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
   o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
+  o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kSobol ? "1" : "0");
   if (s.aov) o += " -D WP_AOV=1";
   return o;
 }

@@ -27,6 +27,8 @@ namespace wp {
 
 enum class Strategy { kMis, kNee, kBsdf };
 enum class MisHeuristic { kPower, kBalance };
+// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points or independent hashes.
+enum class Sampler { kSobol, kIndependent };
 
 struct RenderSettings {
   int width = 640;
@@ -50,6 +52,7 @@ struct RenderSettings {
   Strategy strategy = Strategy::kMis;
   MisHeuristic mis_heuristic = MisHeuristic::kPower;
   LightSelect light_select = LightSelect::kPower;
+  Sampler sampler = Sampler::kSobol;
   int camera = -1;             // index into Scene::cameras; -1: the first, or a framing camera
   bool all_features = false;   // build every kernel feature regardless of the scene
   std::size_t wave_size = 0;   // path slots per wave; 0: min(pixels, 2^20)

@@ -39,6 +39,13 @@
 #define WP_FEATURE_VOLUME 1 /* KHR_materials_volume: refraction and absorption */
 #endif
 
+/* Sample pattern (rng.h): Owen-scrambled Sobol' or independent hashes. */
+#define WP_SAMPLER_INDEPENDENT 0
+#define WP_SAMPLER_SOBOL 1
+#ifndef WP_SAMPLER
+#define WP_SAMPLER WP_SAMPLER_SOBOL
+#endif
+
 /* Sampling strategy for direct light: full MIS of NEE and BSDF sampling, NEE only, BSDF only. */
 #define WP_STRATEGY_MIS 0
 #define WP_STRATEGY_NEE 1

@@ -194,6 +194,10 @@ wp::Scene agreement_scene() {
 
 wp::RenderSettings agreement_settings() {
   wp::RenderSettings st;
+  // The z-scores below take each pixel's error variance from the film's variance image, which is
+  // what it is for independent samples only; the Sobol' pattern is tested in tests/test_rng.cpp
+  // and against known answers in tests/test_render_known.cpp.
+  st.sampler = wp::Sampler::kIndependent;
   st.width = 48;
   st.height = 36;
   st.spp = 256;
@@ -380,6 +384,7 @@ TEST_P(EmissiveQuad, MatchesLambertsFormula) {
   const vec3 eye(0.0f, 2.5f, 2.5f);
   s.cameras.push_back(wp::test::look_at(eye, {0.0f, 0.0f, 0.0f}, 0.7f));
   wp::RenderSettings st;
+  st.sampler = wp::Sampler::kIndependent;  // z-scores from variance images: see agreement_settings
   st.width = 40;
   st.height = 30;
   st.spp = 1024;

@@ -74,11 +74,22 @@ PixelMoments integrate(const wp::dev::Camera& cam, const std::function<dvec3(dve
   return m;
 }
 
-void expect_matches(const wp::Rendered& r, const PixelMoments& expected) {
+// Checks a render against the known pixel means. z = (got - expected) / sigma, sigma the standard
+// error kSpp independent samples would have (from the known per-pixel spread) plus a rounding
+// floor. Independent samples: every |z| < 6 and mean z^2 = 1 within 5 of its standard errors
+// (sqrt(2 / n)), a two-sided test of both the value and the error model. Sobol' samples have
+// less error than that model, so: every |z| < 6, mean z^2 <= 1 + 5 sqrt(2 / n) (no noisier than
+// independent samples), and unbiasedness by the self-normalised sum over pixels: with D_p the
+// pixel's error summed over channels, independent across pixels (independent scrambles) with
+// mean 0 for an unbiased render, |sum D_p| / sqrt(sum D_p^2) ~ |N(0, 1)| < 5.
+void expect_matches(const wp::Rendered& r, const PixelMoments& expected,
+                    wp::Sampler sampler = wp::Sampler::kIndependent) {
   EXPECT_EQ(r.report.nonfinite_samples, 0u);
-  double z2 = 0.0, worst = 0.0;
+  double z2 = 0.0, worst = 0.0, sum_d = 0.0, sum_d2 = 0.0;
   int n = 0;
-  for (std::size_t p = 0; p < expected.mean.size(); ++p)
+  for (std::size_t p = 0; p < expected.mean.size(); ++p) {
+    double d_pixel = 0.0;
+    bool noisy = false;
     for (int c = 0; c < 3; ++c) {
       const double e = expected.mean[p][c], got = r.image.rgb[3 * p + c];
       const double mc = expected.sigma[p][c] * expected.sigma[p][c] / kSpp;
@@ -92,10 +103,31 @@ void expect_matches(const wp::Rendered& r, const PixelMoments& expected) {
       if (mc > 100.0 * rounding) {
         z2 += z * z;
         ++n;
+        d_pixel += got - e;
+        noisy = true;
       }
     }
-  if (n >= 100) {
+    if (noisy) {
+      sum_d += d_pixel;
+      sum_d2 += d_pixel * d_pixel;
+    }
+  }
+  if (n < 100) return;
+  if (sampler == wp::Sampler::kIndependent) {
     EXPECT_NEAR(z2 / n, 1.0, 5.0 * std::sqrt(2.0 / n)) << n << " pixels, worst |z| " << worst;
+  } else {
+    EXPECT_LE(z2 / n, 1.0 + 5.0 * std::sqrt(2.0 / n)) << n << " pixels, worst |z| " << worst;
+    EXPECT_LT(std::fabs(sum_d), 5.0 * std::sqrt(sum_d2)) << "sum of errors " << sum_d;
+  }
+}
+
+// Renders s with each sample pattern and checks both against the known answer.
+void expect_matches_with_each_sampler(wp::ClRuntime& runtime, const wp::Scene& s,
+                                      wp::RenderSettings st, const PixelMoments& expected) {
+  for (wp::Sampler sampler : {wp::Sampler::kIndependent, wp::Sampler::kSobol}) {
+    SCOPED_TRACE(sampler == wp::Sampler::kSobol ? "sobol" : "independent");
+    st.sampler = sampler;
+    expect_matches(wp::render(runtime, s, st), expected, sampler);
   }
 }
 
@@ -115,6 +147,7 @@ wp::RenderSettings settings_for(const wp::Scene& s, vec3 background) {
   st.spp = kSpp;
   st.background = background;
   st.camera = 0;
+  st.sampler = wp::Sampler::kIndependent;  // expect_matches_with_each_sampler tries both
   (void)s;
   return st;
 }
@@ -147,7 +180,7 @@ TEST_F(RenderKnown, SmoothMetalShowsSchlickFresnel) {
     const double c = -d.y;
     return dvec3(0.5 + 0.5 * std::pow(1.0 - c, 5.0));
   });
-  expect_matches(wp::render(*runtime_, s, st), expected);
+  expect_matches_with_each_sampler(*runtime_, s, st, expected);
 }
 
 // The glTF metallic-roughness BRDF (specification appendix B), written independently of the
@@ -216,7 +249,7 @@ TEST_P(RenderPunctual, PlaneShowsBrdfTimesIrradiance) {
     }
     return gltf_brdf(n, -d, wi, base, lc.metallic, lc.roughness) * std::max(0.0, wi.y) * irradiance;
   });
-  expect_matches(wp::render(*runtime_, s, st), expected);
+  expect_matches_with_each_sampler(*runtime_, s, st, expected);
 }
 
 wp::PunctualLight point_light() {
@@ -281,7 +314,7 @@ TEST_F(RenderKnown, SunThroughThinGlassPane) {
     if (!plane_hit(eye, d, &p)) return dvec3(0.0);
     return gltf_brdf(n, -d, wi, base, 0.0, 1.0) * wi.y * dvec3(sun.intensity) * (1.0 - fresnel);
   });
-  expect_matches(wp::render(*runtime_, s, st), expected);
+  expect_matches_with_each_sampler(*runtime_, s, st, expected);
 }
 
 // An emissive quad facing the camera shows its radiance; seen from behind it is not there when
@@ -370,27 +403,31 @@ wp::Scene busy_scene() {
 // another image.
 TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
   const wp::Scene s = busy_scene();
-  wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
-  st.spp = 4;
-  st.seed = 11;
-  const auto reference = wp::render(*runtime_, s, st).image.rgb;
-  double sum = 0.0;
-  for (float v : reference) sum += v;
-  EXPECT_GT(sum, 0.0);
-  for (const auto& [wave, local] : std::vector<std::pair<std::size_t, std::size_t>>{
-           {0, 0}, {1000, 0}, {777, 8}, {0, 64}, {256, 32}}) {
-    st.wave_size = wave;
-    st.local_size = local;
-    const auto image = wp::render(*runtime_, s, st).image.rgb;
-    ASSERT_EQ(image.size(), reference.size());
-    EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))
-        << "wave " << wave << " local " << local;
+  for (wp::Sampler sampler : {wp::Sampler::kSobol, wp::Sampler::kIndependent}) {
+    SCOPED_TRACE(sampler == wp::Sampler::kSobol ? "sobol" : "independent");
+    wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
+    st.sampler = sampler;
+    st.spp = 4;
+    st.seed = 11;
+    const auto reference = wp::render(*runtime_, s, st).image.rgb;
+    double sum = 0.0;
+    for (float v : reference) sum += v;
+    EXPECT_GT(sum, 0.0);
+    for (const auto& [wave, local] : std::vector<std::pair<std::size_t, std::size_t>>{
+             {0, 0}, {1000, 0}, {777, 8}, {0, 64}, {256, 32}}) {
+      st.wave_size = wave;
+      st.local_size = local;
+      const auto image = wp::render(*runtime_, s, st).image.rgb;
+      ASSERT_EQ(image.size(), reference.size());
+      EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))
+          << "wave " << wave << " local " << local;
+    }
+    st.wave_size = 0;
+    st.local_size = 0;
+    st.seed = 12;
+    const auto other = wp::render(*runtime_, s, st).image.rgb;
+    EXPECT_NE(0, std::memcmp(other.data(), reference.data(), other.size() * sizeof(float)));
   }
-  st.wave_size = 0;
-  st.local_size = 0;
-  st.seed = 12;
-  const auto other = wp::render(*runtime_, s, st).image.rgb;
-  EXPECT_NE(0, std::memcmp(other.data(), reference.data(), other.size() * sizeof(float)));
 }
 
 }  // namespace

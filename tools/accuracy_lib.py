@@ -11,8 +11,8 @@ v_x, against a reference r with variance image v_r, which is 0 for a closed form
 - relMSE = mean(((x - r)^2 - v_r) / (r^2 + 0.01)): the MSE relative to the pixel's squared value;
   the 0.01 keeps pixels darker than ~0.1 from dominating.
 - bias: the image mean's difference d = mean(x) - mean(r), for each channel and for the mean of
-  the three. Pixels are independent (wavepath's random numbers are a hash of pixel, sample and
-  seed), so Var d = (sum v_x + sum v_r) / n_pixels^2 per channel. For the mean of the channels,
+  the three. Pixels are independent (with --sampler independent, the default here, wavepath's
+  random numbers are a hash of pixel, sample and seed), so Var d = (sum v_x + sum v_r) / n_pixels^2 per channel. For the mean of the channels,
   whose covariance the variance images do not give, each pixel's variance is bounded by
   (mean of the channel standard deviations)^2 (full correlation, Cauchy-Schwarz): that CI is
   conservative. The 95% interval is d +- 1.96 sqrt(Var d); z = d / sqrt(Var d).
@@ -35,8 +35,12 @@ REFERENCE_SEED = 987654321  # never used for the runs compared with a reference
 # ---- Configurations ------------------------------------------------------------------------------
 # A configuration is a strategy with optional settings: "mis", "nee", "bsdf", then any of
 # "+heuristic=power|balance", "+select=power|uniform", "+rr=off|N" (Russian roulette after N
-# scattering events; off: none), "+depth=N" (--max-depth). Unset settings are wavepath's defaults
-# (power heuristic, power light selection, roulette after 5, max depth 12).
+# scattering events; off: none), "+depth=N" (--max-depth), "+sampler=independent|sobol". Unset
+# settings are wavepath's defaults (power heuristic, power light selection, roulette after 5, max
+# depth 12) except the sampler: independent, because every statistic here takes a pixel's error
+# variance from wavepath's variance image, which is that only for independent samples (Sobol'
+# points have less error than their sample variance says, so MSEs net of the reference's variance
+# and z-scores would be wrong).
 
 DEFAULT_CONFIGS = ("mis", "nee", "bsdf", "mis+heuristic=balance", "mis+select=uniform",
                    "mis+rr=off", "mis+rr=1")
@@ -49,6 +53,7 @@ def config_args(config):
     if strategy not in ("mis", "nee", "bsdf"):
         raise ValueError("configuration %r: strategy must be mis, nee or bsdf" % config)
     args = ["--strategy", strategy]
+    sampler = "independent"
     for part in parts[1:]:
         key, sep, value = part.partition("=")
         if not sep:
@@ -63,9 +68,11 @@ def config_args(config):
             args += ["--rr-depth", value]
         elif key == "depth" and value.isdigit():
             args += ["--max-depth", value]
+        elif key == "sampler" and value in ("independent", "sobol"):
+            sampler = value
         else:
             raise ValueError("configuration %r: unknown setting %r" % (config, part))
-    return args
+    return args + ["--sampler", sampler]
 
 
 # ---- Manifest ------------------------------------------------------------------------------------
