@@ -33,6 +33,11 @@ SceneFeatures SceneFeatures::of(const Scene& scene, bool has_environment_map) {
   f.transmission = any(
       m, [](const Material& x) { return x.transmission > 0.0f || x.transmission_texture >= 0; });
   f.volume = f.transmission && any(m, [](const Material& x) { return x.thickness > 0.0f; });
+  // Without a specular layer (glTF's default metallic is 1, its default specular factor 1), the
+  // BSDF is Lambert's alone (kernels/bsdf.h). Unlit materials scatter nothing.
+  f.glossy = f.transmission || any(m, [](const Material& x) {
+               return !x.unlit && (x.metallic > 0.0f || x.specular > 0.0f);
+             });
   return f;
 }
 
@@ -46,6 +51,7 @@ std::vector<std::pair<std::string, bool>> SceneFeatures::flags() const {
           {"WP_FEATURE_NORMAL_MAPS", normal_maps},
           {"WP_FEATURE_ALPHA", alpha},
           {"WP_FEATURE_UNLIT", unlit},
+          {"WP_FEATURE_GLOSSY", glossy},
           {"WP_FEATURE_TRANSMISSION", transmission},
           {"WP_FEATURE_VOLUME", volume}};
 }

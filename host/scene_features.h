@@ -20,6 +20,7 @@ struct SceneFeatures {
   bool normal_maps = true;
   bool alpha = true;
   bool unlit = true;
+  bool glossy = true;  // a scattering material with metallic > 0, specular > 0 or transmission
   bool transmission = true;
   bool volume = true;
 

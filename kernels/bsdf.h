@@ -30,6 +30,10 @@
  * bsdf_eval returns for the pair. Directions are world-space unit vectors pointing away from the
  * surface; wo is toward the viewer. Surfaces seen from the back of a volume (the ray travels
  * inside) have the relative index of refraction 1 / ior.
+ *
+ * Built with WP_FEATURE_GLOSSY 0 (a scene whose every scattering material has metallic 0,
+ * specular factor 0 and no transmission: host/scene_features.cpp), f reduces to base / pi, and
+ * evaluation and sampling are Lambert's alone: the same values, without the lobe machinery.
  */
 #ifndef WP_BSDF_H
 #define WP_BSDF_H
@@ -82,7 +86,12 @@ typedef struct Lobes {
 } Lobes;
 
 static inline bool bsdf_has_delta(const Surface* s) {
+#if WP_FEATURE_GLOSSY
   return sqr(s->roughness) < WP_DELTA_ALPHA;
+#else
+  (void)s; /* a Lambertian surface has no delta lobe at any roughness */
+  return false;
+#endif
 }
 static inline bool bsdf_transmits(const Surface* s) {
 #if WP_FEATURE_TRANSMISSION
@@ -236,6 +245,40 @@ static inline void eval_transmission(const Surface* s, float3 wo, float3 wi, flo
   e->pdf = g * (1.0f - reflect_prob(w)) * ggx_g1(cos_o, alpha) * o_h * d / cos_o * jacobian;
 }
 
+#if !WP_FEATURE_GLOSSY
+
+/* Lambert: f = base / pi and the cosine-weighted pdf, for wi above both normals. */
+static inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
+  BsdfEval e = {(float3)(0.0f), 0.0f};
+  const float cos_i = dot(s->ns, wi);
+  if (!(dot(s->ns, wo) > 0.0f) || !(cos_i > 0.0f && dot(s->ng, wi) > 0.0f)) return e;
+  e.f = WP_INV_PI * s->color;
+  e.pdf = cosine_hemisphere_pdf(cos_i);
+  return e;
+}
+
+/* A cosine-weighted direction; its weight f cos / pdf is the base colour. */
+static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
+  (void)u_lobe;
+  BsdfSample r;
+  r.valid = false, r.delta = false, r.pdf = 0.0f, r.eta_scale = 1.0f;
+  r.weight = (float3)(0.0f), r.wi = (float3)(0.0f);
+  if (!(dot(s->ns, wo) > 0.0f)) return r;
+  float3 t, b;
+  make_basis(s->ns, &t, &b);
+  const float3 wi_l = sample_cosine_hemisphere(u);
+  if (!(wi_l.z > 0.0f)) return r;
+  r.wi = normalize(wi_l.x * t + wi_l.y * b + wi_l.z * s->ns);
+  const float cos_i = dot(s->ns, r.wi);
+  if (!(cos_i > 0.0f && dot(s->ng, r.wi) > 0.0f)) return r; /* bsdf_eval's pdf is 0 there */
+  r.pdf = cosine_hemisphere_pdf(cos_i);
+  r.weight = s->color;
+  r.valid = true;
+  return r;
+}
+
+#else
+
 static inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
   BsdfEval e = {(float3)(0.0f), 0.0f};
   const float cos_i = dot(s->ns, wi), cos_o = dot(s->ns, wo);
@@ -342,5 +385,7 @@ static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, 
   r.valid = true;
   return r;
 }
+
+#endif /* WP_FEATURE_GLOSSY */
 
 #endif /* WP_BSDF_H */

@@ -32,6 +32,9 @@
 #ifndef WP_FEATURE_UNLIT
 #define WP_FEATURE_UNLIT 1 /* KHR_materials_unlit */
 #endif
+#ifndef WP_FEATURE_GLOSSY
+#define WP_FEATURE_GLOSSY 1 /* a specular layer (metallic or specular factor > 0, transmission) */
+#endif
 #ifndef WP_FEATURE_TRANSMISSION
 #define WP_FEATURE_TRANSMISSION 1 /* KHR_materials_transmission */
 #endif

@@ -106,14 +106,19 @@ static inline uint rng_owen(uint x, uint seed) {
   return rng_reverse_bits(rng_nested_permute(rng_reverse_bits(x), seed));
 }
 
-/* The second Sobol' dimension: generator matrix = Pascal's triangle mod 2 (direction numbers
- * v_0 = 1/2, v_{k+1} = v_k xor v_k / 2). The first dimension is rng_reverse_bits (van der Corput).
- */
-static inline uint rng_sobol1(uint i) {
-  uint v = 0x80000000u, x = 0u;
-  for (; i != 0u; i >>= 1, v ^= v >> 1)
-    if (i & 1u) x ^= v;
-  return x;
+/* The second Sobol' dimension, Owen-scrambled. Its generator matrix is Pascal's triangle mod 2
+ * (direction numbers v_0 = 1/2, v_{k+1} = v_k xor v_k / 2), so with the index's bits as the
+ * coefficients of a polynomial I(t), the point's digits are those of I(1 + t): a Taylor shift by 1,
+ * which over GF(2) takes five shift-xor steps ((1 + t)^(2^j) = 1 + t^(2^j), so each half of a
+ * block of 2^(j+1) coefficients adds its upper half to its lower one). The result is the point
+ * with its digits reversed, which is what Owen scrambling permutes (rng_owen) before reversing. */
+static inline uint rng_sobol_second(uint index, uint seed) {
+  index ^= (index >> 16) & 0x0000ffffu;
+  index ^= (index >> 8) & 0x00ff00ffu;
+  index ^= (index >> 4) & 0x0f0f0f0fu;
+  index ^= (index >> 2) & 0x33333333u;
+  index ^= (index >> 1) & 0x55555555u;
+  return rng_reverse_bits(rng_nested_permute(index, wp_hash(seed ^ 0x1b873593u)));
 }
 
 /* The first Sobol' dimension, van der Corput, Owen-scrambled: owen(reverse(i)) =
@@ -139,7 +144,7 @@ static inline float2 rng_get2(Rng r, uint dim) {
   const uint seed = rng_group_seed(r, dim);
   const uint index = rng_owen(r.sample, seed);
   return (float2)(rng_float(rng_van_der_corput(index, seed)),
-                  rng_float(rng_owen(rng_sobol1(index), wp_hash(seed ^ 0x1b873593u))));
+                  rng_float(rng_sobol_second(index, seed)));
 }
 
 #else

@@ -8,6 +8,7 @@
 // one |z| exceeds 6 (N <= ~3000 values: a false alarm has probability < 1e-5). Where a pixel's
 // estimate has heavy tails (BSDF sampling that finds a light rarely), values are summed over
 // pixel blocks first, which brings them close to Gaussian.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -21,6 +22,7 @@
 #include "host/image_io.h"
 #include "host/light_table.h"
 #include "host/render.h"
+#include "host/scene_features.h"
 #include "tests/scene_factory.h"
 
 namespace {
@@ -227,6 +229,32 @@ std::shared_ptr<const wp::EnvironmentMap> test_sky() {
     }
   wp::build_environment_tables(*env);
   return env;
+}
+
+// A scene whose materials have no specular layer (metallic 0, KHR_materials_specular factor 0)
+// builds the Lambert-only BSDF (WP_FEATURE_GLOSSY 0, kernels/bsdf.h). It must render what the
+// general BSDF renders with the same random numbers: the values agree up to float rounding (1e-4
+// relative; a path can take another turn where a roulette or lobe decision sits within rounding
+// of its threshold, about once per 10^6 decisions, so up to 0.5% of pixels may differ more), and
+// both renders agree within their standard errors (z-scores over 4 x 4 blocks).
+TEST_F(LightTransport, LambertOnlyBuildRendersAsTheGeneralBsdf) {
+  wp::Scene s = agreement_scene();
+  EXPECT_TRUE(wp::SceneFeatures::of(s, false).glossy);  // the floor is partly metal
+  for (wp::Material& m : s.materials) m.metallic = 0.0f, m.specular = 0.0f;
+  ASSERT_FALSE(wp::SceneFeatures::of(s, false).glossy);
+  wp::RenderSettings st = agreement_settings();
+  st.spp = 64;
+  const wp::Rendered lambert = render(s, st);
+  st.all_features = true;
+  const wp::Rendered general = render(s, st);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < lambert.image.rgb.size(); ++i) {
+    const float a = lambert.image.rgb[i], b = general.image.rgb[i];
+    differ += std::fabs(a - b) > 1e-4f * std::max(std::fabs(b), 1e-3f);
+  }
+  EXPECT_LE(differ, lambert.image.rgb.size() / 200) << differ << " values differ";
+  st.seed = 1;
+  expect_agree(lambert, render(s, st), 4, "lambert-only vs general, other seed");
 }
 
 class StrategiesAgree : public LightTransport, public ::testing::WithParamInterface<bool> {};

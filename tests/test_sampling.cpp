@@ -12,7 +12,7 @@
 //   f |cos| / pdf (relative 1e-4); delta samples lie on the exact mirror/refraction direction.
 //
 // False alarms: a correct routine fails one configuration's chi-square with probability 1e-4 (the
-// 5-sigma checks add ~1e-6); over the 140 configurations here that is at most 1.4% (union bound)
+// 5-sigma checks add ~1e-6); over the 158 configurations here that is at most 1.6% (union bound)
 // for a random choice of seeds. Seeds are fixed, so a given build on a given device passes or
 // fails reproducibly; a change of the random stream (new code, another device's rounding) draws
 // anew from that 1.4%.
@@ -85,7 +85,8 @@ struct Config {
   // reaches).
   std::vector<float4> triangle = {{-1.1f, -0.9f, 1, 1}, {0.1f, 1.05f, 1, 1}, {0.95f, -1.05f, 1, 1}};
   bool double_sided = false;
-  bool all_valid = false;  // every sample valid and non-delta: the pdf integrates to 1
+  bool all_valid = false;      // every sample valid and non-delta: the pdf integrates to 1
+  bool lambert_build = false;  // run on the Lambert-only build (Device::get)
   Quadrature quadrature = kSmooth;
 };
 
@@ -118,9 +119,15 @@ struct Integrals {
 // The test kernels, built once per process, and the sample buffers every draw reuses.
 class Device {
  public:
-  static Device& get() {
-    static Device d;
-    return d;
+  // The program with every feature, or the Lambert-only build of a scene without a specular
+  // layer (WP_FEATURE_GLOSSY 0: kernels/bsdf.h). Each is built on first use.
+  static Device& get(bool lambert_build) {
+    if (lambert_build) {
+      static Device lambert("-D WP_FEATURE_GLOSSY=0 -D WP_FEATURE_TRANSMISSION=0");
+      return lambert;
+    }
+    static Device general("");
+    return general;
   }
 
   Draw draw(const Config& c) {
@@ -173,7 +180,7 @@ class Device {
   wp::test::KernelHarness& harness() { return h_; }
 
  private:
-  Device() : h_({"sampling_kernels.cl"}) {
+  explicit Device(const std::string& options) : h_({"sampling_kernels.cl"}, options) {
     dirs_ = h_.buffer<float4>(std::size_t{kSamples});
     checks_ = h_.buffer<float4>(std::size_t{kSamples});
   }
@@ -209,7 +216,7 @@ std::vector<std::size_t> iota(std::size_t n) {
 Integrals make_bins(const Config& c, SphereBins& bins) {
   const auto base_count = static_cast<std::size_t>(bins.base_count());
   Integrals base(base_count);
-  Device::get().integrate(c, bins.rects(), c.quadrature, iota(base_count), base);
+  Device::get(c.lambert_build).integrate(c, bins.rects(), c.quadrature, iota(base_count), base);
   std::vector<int> split(base_count);
   for (std::size_t b = 0; b < base_count; ++b) {
     const double parts = std::ceil(std::sqrt(kSamples * base.value[b] / kTargetPerBin));
@@ -228,7 +235,7 @@ Integrals make_bins(const Config& c, SphereBins& bins) {
     }
     for (std::size_t k = first; k < first + m * m; ++k) parts.push_back(rects[k]), at.push_back(k);
   }
-  Device::get().integrate(c, parts, c.quadrature, at, in);
+  Device::get(c.lambert_build).integrate(c, parts, c.quadrature, at, in);
   return in;
 }
 
@@ -252,7 +259,8 @@ Fit fit(const Config& c, const Draw& d) {
   std::vector<std::size_t> again_at;
   for (std::size_t b = 0; b < bins.size(); ++b)
     if (in.value[b] <= 0.0 && observed[b] > 0.0) again.push_back(rects[b]), again_at.push_back(b);
-  if (again.size() <= kMaxRescued) Device::get().integrate(c, again, kRescue, again_at, in);
+  if (again.size() <= kMaxRescued)
+    Device::get(c.lambert_build).integrate(c, again, kRescue, again_at, in);
   Fit f;
   f.total = std::accumulate(in.value.begin(), in.value.end(), 0.0);
   f.total_error = std::accumulate(in.error.begin(), in.error.end(), 0.0);
@@ -280,7 +288,7 @@ double pdf_rounding(const Config& c) {
 // for further checks by the caller.
 Draw check_config(const Config& c) {
   SCOPED_TRACE(c.name);
-  const Draw d = Device::get().draw(c);
+  const Draw d = Device::get(c.lambert_build).draw(c);
   const Fit f = fit(c, d);
   const double n = kSamples, smooth = static_cast<double>(d.smooth) / n;
   // Integration error: 3x the sum of the per-bin estimates (on smooth integrands each is many
@@ -328,7 +336,7 @@ Config bsdf_config(float metallic, float roughness, float4 color, double view_de
 void check_bsdf(const Config& c) {
   const Draw d = check_config(c);
   SCOPED_TRACE(c.name);
-  const std::vector<float> lobes = Device::get().lobes(c);
+  const std::vector<float> lobes = Device::get(c.lambert_build).lobes(c);
   const double n = kSamples, spec = lobes[0], trans = lobes[1];
   const bool smooth = c.params.y * c.params.y < 1e-3f;  // WP_DELTA_ALPHA
   if (smooth) {
@@ -389,6 +397,19 @@ TEST(Sampling, GltfBrdfSmoothSpecular) {
       for (double view : {0.0, 45.0, 80.0}) check_bsdf(bsdf_config(metallic, 0.0f, color, view));
 }
 
+// The Lambert-only build (a scene without specular layers): the cosine lobe at every roughness,
+// smooth included (no delta lobe), and f cos / pdf = base colour (the weight check).
+TEST(Sampling, LambertOnlyBuild) {
+  for (float roughness : {0.0f, 0.5f, 1.0f})
+    for (float4 color : {kWhite, kSaturated})
+      for (double view : {0.0, 45.0, 80.0}) {
+        Config c = bsdf_config(0.0f, roughness, color, view);
+        c.name += " lambert-only build";
+        c.lambert_build = true;
+        check_bsdf(c);
+      }
+}
+
 // Dielectric transmission (KHR_materials_transmission, ior 1.5), thin-walled and with a volume
 // (KHR_materials_volume). "Inside" is what bsdf.h's Surface says: the normals always face wo, and
 // WP_SURF_FRONT is clear on a WP_SURF_VOLUME surface when the ray arrived on the back side, from
@@ -447,7 +468,7 @@ TEST(Sampling, LightPick) {
         i % 7 == 3 ? 0.0 : std::pow(10.0, 4.0 * std::fmod(0.618034 * static_cast<double>(i), 1.0));
   const std::vector<std::vector<double>> tables = {
       {1.0}, {0, 5, 0.5, 0, 20, 1, 1, 1e-3, 3, 0}, {0, 0, 1}, many};
-  auto& h = Device::get().harness();
+  auto& h = Device::get(false).harness();
   cl::Buffer chosen = h.buffer<std::uint32_t>(std::size_t{kSamples});
   cl::Buffer pmfs = h.buffer<float>(std::size_t{kSamples});
   for (std::size_t t = 0; t < tables.size(); ++t) {

@@ -52,7 +52,11 @@ inline float3 to_world(float3 l, float3 t, float3 b, float3 n) {
 inline Surface config_surface(const Config* c) {
   Surface s = {0};
   s.ng = s.ns = tilted_normal();
+#if WP_FEATURE_GLOSSY
   s.specular = 1.0f; /* KHR_materials_specular's default */
+#else
+  s.specular = 0.0f; /* what the materials of a scene built without WP_FEATURE_GLOSSY have */
+#endif
   s.color = c->color.xyz;
   s.metallic = c->params.x;
   s.roughness = c->params.y;
