@@ -44,6 +44,7 @@ struct CliOptions {
   std::string heuristic = "power";
   std::string light_select = "power";
   std::string sampler = "sobol";
+  std::string pipeline = "split";
   bool no_rr = false;
   bool variance = false;
   bool no_bvh_cache = false;
@@ -298,6 +299,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   settings.light_select =
       cli.light_select == "uniform" ? wp::LightSelect::kUniform : wp::LightSelect::kPower;
   settings.sampler = cli.sampler == "independent" ? wp::Sampler::kIndependent : wp::Sampler::kSobol;
+  settings.fused = cli.pipeline == "fused";
   if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);
   if (!cli.env.empty())
@@ -614,6 +616,12 @@ int main(int argc, char** argv) {
                    "Sample pattern: sobol (Owen-scrambled Sobol' points per pixel: less error "
                    "for the same samples) or independent (a hash per random number)")
       ->check(CLI::IsMember({"sobol", "independent"}))
+      ->capture_default_str();
+  render
+      ->add_option("--pipeline", cli.pipeline,
+                   "fused (one kernel per bounce for all the work at a hit) or split (a kernel "
+                   "per stage, for kernel work and per-stage timing); the same image bit for bit")
+      ->check(CLI::IsMember({"fused", "split"}))
       ->capture_default_str();
   render->add_option("--max-depth", settings.max_depth, "Most scattering events per path")
       ->capture_default_str();

@@ -14,13 +14,15 @@ enum class Stage : int {
   kTraceShadow,         // shadow queue -> unoccluded contributions
   kSampleBsdf,          // surface queue -> next rays, throughput, pdf, delta flag
   kRouletteCompact,     // surface queue -> next ray queue (survivors)
+  kShade,               // fused: hits -> shadow queue, next ray queue (the four stages above but
+                        // trace_shadow in one kernel; RenderSettings::fused)
   kAccumulate,          // wave -> film
 };
-inline constexpr int kStageCount = 8;
+inline constexpr int kStageCount = 9;
 
 inline constexpr std::array<const char*, kStageCount> kStageNames = {
-    "generate_camera_rays", "intersect_closest", "shade_surface",    "sample_lights",
-    "trace_shadow",         "sample_bsdf",       "roulette_compact", "accumulate"};
+    "generate_camera_rays", "intersect_closest", "shade_surface", "sample_lights", "trace_shadow",
+    "sample_bsdf",          "roulette_compact",  "shade",         "accumulate"};
 
 inline const char* stage_name(Stage s) {
   return kStageNames[static_cast<int>(s)];

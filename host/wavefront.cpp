@@ -238,11 +238,16 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
   rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
                                  counters.data());
   launch(Stage::kIntersectClosest, rays, p);
-  launch(Stage::kShadeSurface, rays, p);
-  launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
-  launch(Stage::kTraceShadow, rays, p);
-  launch(Stage::kSampleBsdf, rays, p);
-  launch(Stage::kRouletteCompact, rays, p);
+  if (settings_.fused) {
+    launch(Stage::kShade, rays, p);  // the queues it fills hold at most `rays` slots
+    launch(Stage::kTraceShadow, rays, p);
+  } else {
+    launch(Stage::kShadeSurface, rays, p);
+    launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
+    launch(Stage::kTraceShadow, rays, p);
+    launch(Stage::kSampleBsdf, rays, p);
+    launch(Stage::kRouletteCompact, rays, p);
+  }
   const std::uint32_t next = read_counter(p.queue_out);
   std::swap(p.queue_in, p.queue_out);
   return next;

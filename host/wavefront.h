@@ -58,7 +58,11 @@ struct RenderSettings {
   std::size_t wave_size = 0;   // path slots per wave; 0: min(pixels, 2^20)
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
-  int bvh_width = 0;           // BVH layout: 2, 8, or 0 for the device's default (render.h)
+  // One fused kernel per bounce for everything at a hit (kernels/shade.cl), or the split stages
+  // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit.
+  // Split by default: on PoCL the fused kernel measured no faster (README, "Fused shading").
+  bool fused = false;
+  int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Most bytes in one scene buffer (device_scene.h); 0: the device's largest allocation. Smaller
   // values split even small scenes over several buffers (tests).
   std::uint64_t scene_buffer_bytes = 0;

@@ -8,10 +8,9 @@
 #include "stage.h"
 #include "surface.h"
 
-__kernel void roulette_compact(WP_STAGE_PARAMS) {
-  WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
+/* Roulette for the path in `slot`; a survivor goes to queue_out. Shared by this stage and the
+ * fused shade.cl. */
+static inline void roulette(Paths paths, Queues queues, Launch launch, uint slot) {
   const float4 beta = paths.throughput[slot];
   if (!all(isfinite(beta))) { /* sample_bsdf catches these first; a NaN is never dropped silently */
     count_nonfinite(queues);
@@ -29,4 +28,11 @@ __kernel void roulette_compact(WP_STAGE_PARAMS) {
   }
   paths.info[slot].y = bounce + 1u;
   queue_push(queues, launch.queue_out, slot);
+}
+
+__kernel void roulette_compact(WP_STAGE_PARAMS) {
+  WP_STAGE_BIND;
+  uint slot;
+  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
+  roulette(paths, queues, launch, slot);
 }

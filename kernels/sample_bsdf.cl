@@ -10,13 +10,12 @@
 #include "stage.h"
 #include "surface.h"
 
-__kernel void sample_bsdf(WP_STAGE_PARAMS) {
-  WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
-  const Surface s = surface_load(paths, slot);
+/* The next ray of the path in `slot` from surface s. Shared by this stage and the fused shade.cl.
+ */
+static inline void sample_next_ray(Paths paths, Queues queues, Launch launch, uint slot,
+                                   const Surface* s) {
   const Rng rng = path_rng(paths, slot, launch);
-  const BsdfSample bs = bsdf_sample(&s, -paths.ray_d[slot].xyz, rng_get(rng, WP_DIM_BSDF_LOBE),
+  const BsdfSample bs = bsdf_sample(s, -paths.ray_d[slot].xyz, rng_get(rng, WP_DIM_BSDF_LOBE),
                                     rng_get2(rng, WP_DIM_BSDF_U));
   const float4 beta = paths.throughput[slot];
   const float3 next = beta.xyz * bs.weight;
@@ -32,7 +31,7 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
    * the path goes on along the direction the previous vertex sampled, so it keeps that sample's
    * pdf and flags for MIS at the next hit, and counts the distance to that vertex (info.w) for the
    * light's pdf there. */
-  if (bs.delta && !bsdf_volume(&s) && dot(bs.wi, s.ng) < 0.0f) {
+  if (bs.delta && !bsdf_volume(s) && dot(bs.wi, s->ng) < 0.0f) {
     paths.throughput[slot] = (float4)(next, beta.w);
     paths.info[slot].w = as_uint(as_float(paths.info[slot].w) + paths.hit[slot].x);
   } else
@@ -44,6 +43,14 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   }
   /* Leave on the side the new direction goes to (below for transmission). */
   paths.ray_o[slot] =
-      (float4)(surface_spawn(&s, paths.ray_d[slot].xyz, paths.hit[slot].x, bs.wi), 0.0f);
+      (float4)(surface_spawn(s, paths.ray_d[slot].xyz, paths.hit[slot].x, bs.wi), 0.0f);
   paths.ray_d[slot] = (float4)(bs.wi, INFINITY);
+}
+
+__kernel void sample_bsdf(WP_STAGE_PARAMS) {
+  WP_STAGE_BIND;
+  uint slot;
+  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
+  const Surface s = surface_load(paths, slot);
+  sample_next_ray(paths, queues, launch, slot, &s);
 }

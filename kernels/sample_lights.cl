@@ -8,21 +8,20 @@
 #include "mis.h"
 #include "surface.h"
 
-__kernel void sample_lights(WP_STAGE_PARAMS) {
-  WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-  if (scene_desc.light_count == 0) return;
-  const Surface s = surface_load(paths, slot);
-  if (bsdf_only_delta(&s)) return;
+/* NEE at surface s of the path in `slot`: a shadow ray into WP_QUEUE_SHADOW. Shared by this stage
+ * and the fused shade.cl. */
+static inline void sample_light_ray(const SceneView* scene, Paths paths, Queues queues,
+                                    Launch launch, uint slot, const Surface* s) {
+  if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return;
   const Rng rng = path_rng(paths, slot, launch);
   const LightSample ls =
-      sample_light(&scene, s.p, rng_get(rng, WP_DIM_LIGHT_PICK), rng_get2(rng, WP_DIM_LIGHT_U));
+      sample_light(scene, s->p, rng_get(rng, WP_DIM_LIGHT_PICK), rng_get2(rng, WP_DIM_LIGHT_U));
   if (!(ls.pdf > 0.0f)) return;
-  const BsdfEval e = bsdf_eval(&s, -paths.ray_d[slot].xyz, ls.wi);
+  const BsdfEval e = bsdf_eval(s, -paths.ray_d[slot].xyz, ls.wi);
   const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
-  const float3 c = paths.throughput[slot].xyz * e.f * ls.li * (fabs(dot(s.ns, ls.wi)) * w / ls.pdf);
+  const float3 c =
+      paths.throughput[slot].xyz * e.f * ls.li * (fabs(dot(s->ns, ls.wi)) * w / ls.pdf);
   if (!all(isfinite(c))) {
     count_nonfinite(queues);
     return;
@@ -31,7 +30,7 @@ __kernel void sample_lights(WP_STAGE_PARAMS) {
   /* The shadow ray leaves the side of the surface the light is on (transmission can light the
    * back) and, for a light at a finite distance, runs from the moved origin to the light's target
    * point (itself moved off an area light's surface): neither end can hit the surface it is on. */
-  const float3 o = surface_spawn(&s, paths.ray_d[slot].xyz, paths.hit[slot].x, ls.wi);
+  const float3 o = surface_spawn(s, paths.ray_d[slot].xyz, paths.hit[slot].x, ls.wi);
   float3 dir = ls.wi;
   float tmax = INFINITY;
   if (ls.dist < INFINITY) {
@@ -40,8 +39,20 @@ __kernel void sample_lights(WP_STAGE_PARAMS) {
     dir = to / tmax;
   }
   paths.shadow_o[slot] = (float4)(o, tmax);
-  paths.shadow_d[slot] = (float4)(dir, 0.0f);
+  /* w: the bounce, for the shadow ray's random numbers (trace_shadow runs after the path's bounce
+   * count may have moved on, in the fused pipeline). */
+  paths.shadow_d[slot] = (float4)(dir, as_float(paths.info[slot].y));
   paths.shadow_l[slot] = (float4)(c, 0.0f);
   queue_push(queues, WP_QUEUE_SHADOW, slot);
+}
+#endif
+
+__kernel void sample_lights(WP_STAGE_PARAMS) {
+  WP_STAGE_BIND;
+  uint slot;
+  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
+#if WP_STRATEGY != WP_STRATEGY_BSDF
+  const Surface s = surface_load(paths, slot);
+  sample_light_ray(&scene, paths, queues, launch, slot, &s);
 #endif
 }

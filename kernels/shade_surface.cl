@@ -22,58 +22,68 @@ static inline void aov_record(Paths paths, uint slot, float3 albedo, float3 norm
 }
 #endif
 
-__kernel void shade_surface(WP_STAGE_PARAMS) {
-  WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
+/* The hit of the path in `slot`: a miss adds the environment's radiance; a hit adds the surface's
+ * emission and resolves the material into *s. True when the path goes on to scatter at *s (not
+ * unlit, fewer than max_depth scattering events so far). Shared by this stage and the fused
+ * shade.cl. */
+static inline bool shade_hit(const SceneView* scene, Paths paths, Launch launch, uint slot,
+                             Surface* s) {
   const float4 hit = paths.hit[slot];
   float4 beta = paths.throughput[slot]; /* w: pdf of the BSDF sample (0: delta or camera) */
   const float3 ray_d = paths.ray_d[slot].xyz;
   if (!(hit.x < INFINITY)) {
-    const float w = mis_weight_bsdf_hit(beta.w, environment_light_pdf(&scene, ray_d));
-    const float3 le = env_radiance(&scene, ray_d);
+    const float w = mis_weight_bsdf_hit(beta.w, environment_light_pdf(scene, ray_d));
+    const float3 le = env_radiance(scene, ray_d);
     paths.radiance[slot].xyz += beta.xyz * le * w;
 #if WP_AOV
     aov_record(paths, slot, clamp(le, 0.0f, 1.0f), (float3)(0.0f));
 #endif
-    return;
+    return false;
   }
   const uint tri = as_uint(hit.w);
-  const uint4 tv = scene.tri_vertices[tri];
+  const uint4 tv = scene->tri_vertices[tri];
   bool front;
-  const Surface s = resolve_surface(&scene, tv, hit.y, hit.z, ray_d, &front);
+  *s = resolve_surface(scene, tv, hit.y, hit.z, ray_d, &front);
 #if WP_AOV
   if (paths.info[slot].y == 0u) /* from the camera, panes passed on the way included */
     paths.aov_albedo[slot].w = hit.x + as_float(paths.info[slot].w);
-  if (!bsdf_only_delta(&s)) aov_record(paths, slot, s.color, s.ns);
+  if (!bsdf_only_delta(s)) aov_record(paths, slot, s->color, s->ns);
 #endif
 #if WP_FEATURE_VOLUME
   /* A ray that reaches the back of a volume travelled inside it: Beer-Lambert absorption with
    * transmittance attenuationColor^(distance / attenuationDistance) (KHR_materials_volume). */
-  const float4 vol = scene.materials[tv.w].volume;
-  if (!front && (s.flags & WP_SURF_VOLUME) && vol.w < INFINITY) {
+  const float4 vol = scene->materials[tv.w].volume;
+  if (!front && (s->flags & WP_SURF_VOLUME) && vol.w < INFINITY) {
     beta.xyz *= pow(vol.xyz, hit.x / vol.w);
     paths.throughput[slot] = beta;
   }
 #endif
 #if WP_FEATURE_EMISSION
-  if (front || (scene.materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) {
-    const float3 le = material_emission(&scene, tv, hit.y, hit.z);
+  if (front || (scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) {
+    const float3 le = material_emission(scene, tv, hit.y, hit.z);
     if (max3(le) > 0.0f) {
       /* Seen from the vertex that sampled the ray: panes passed on the way add their distance. */
       const float dist = hit.x + as_float(paths.info[slot].w);
-      const float p_light = triangle_light_pdf(&scene, tri, dist, dot(s.ng, ray_d));
+      const float p_light = triangle_light_pdf(scene, tri, dist, dot(s->ng, ray_d));
       paths.radiance[slot].xyz += beta.xyz * le * mis_weight_bsdf_hit(beta.w, p_light);
     }
   }
 #endif
 #if WP_FEATURE_UNLIT
-  if (s.flags & WP_SURF_UNLIT) { /* shows its colour as emitted radiance; nothing scatters */
-    paths.radiance[slot].xyz += beta.xyz * s.color;
-    return;
+  if (s->flags & WP_SURF_UNLIT) { /* shows its colour as emitted radiance; nothing scatters */
+    paths.radiance[slot].xyz += beta.xyz * s->color;
+    return false;
   }
 #endif
-  if (paths.info[slot].y >= launch.max_depth) return;
+  return paths.info[slot].y < launch.max_depth;
+}
+
+__kernel void shade_surface(WP_STAGE_PARAMS) {
+  WP_STAGE_BIND;
+  uint slot;
+  if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
+  Surface s;
+  if (!shade_hit(&scene, paths, launch, slot, &s)) return;
   surface_store(paths, slot, &s);
   queue_push(queues, WP_QUEUE_SURFACE, slot);
 }

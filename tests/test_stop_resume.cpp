@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -131,31 +132,44 @@ TEST_F(StopResume, TimeLimitStopsWithTheSamplesDone) {
 // pixels' chi-square-like terms, scattered by about 16% between seeds here (relative errors
 // 0.125-0.156 against estimates of 0.141-0.145); the mean of four by about 8%, so the measured
 // mean square may differ from the estimated one by 30% (about 4 standard deviations) at most.
+// That is with independent samples, which the estimator assumes. With Sobol' points (the
+// default) the pixels' sample variance overstates their error, so the estimate is an upper
+// bound: measured / estimated <= 1.3.
 TEST_F(StopResume, RelativeErrorEstimatesTheErrorAgainstAReference) {
-  ASSERT_EQ(run(scene_args() + "--spp 8192 --seed 99 -q -o ref.wpfilm").status, 0);
+  ASSERT_EQ(
+      run(scene_args() + "--spp 8192 --seed 99 --sampler independent -q -o ref.wpfilm").status, 0);
   const wp::FilmImages ref = wp::Film::read(path("ref.wpfilm")).images();
   double eps = 0;
   for (const float v : ref.mean) eps += v;
   eps = 0.01 * eps / double(ref.mean.size());
-  double measured = 0, estimated = 0;
-  for (int seed = 1; seed <= 4; ++seed) {
-    const CliRun r = run(scene_args() + "--spp 64 -q -o s.wpfilm --seed " + std::to_string(seed));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const wp::FilmImages x = wp::Film::read(path("s.wpfilm")).images();
-    double sum = 0;
-    for (std::size_t i = 0; i + 2 < x.mean.size(); i += 3) {
-      double err = 0, value = 3 * eps * eps;
-      for (std::size_t c = i; c < i + 3; ++c) {
-        err += (double(x.mean[c]) - ref.mean[c]) * (double(x.mean[c]) - ref.mean[c]);
-        value += double(ref.mean[c]) * ref.mean[c];
+  for (const char* sampler : {"independent", "sobol"}) {
+    double measured = 0, estimated = 0;
+    for (int seed = 1; seed <= 4; ++seed) {
+      const CliRun r = run(scene_args() + "--spp 64 -q -o s.wpfilm --sampler " + sampler +
+                           " --seed " + std::to_string(seed));
+      ASSERT_EQ(r.status, 0) << r.err;
+      const wp::FilmImages x = wp::Film::read(path("s.wpfilm")).images();
+      double sum = 0;
+      for (std::size_t i = 0; i + 2 < x.mean.size(); i += 3) {
+        double err = 0, value = 3 * eps * eps;
+        for (std::size_t c = i; c < i + 3; ++c) {
+          err += (double(x.mean[c]) - ref.mean[c]) * (double(x.mean[c]) - ref.mean[c]);
+          value += double(ref.mean[c]) * ref.mean[c];
+        }
+        sum += err / value;
       }
-      sum += err / value;
+      measured += sum / double(x.mean.size() / 3) / 4;
+      estimated += wp::relative_error(x) * wp::relative_error(x) / 4;
     }
-    measured += sum / double(x.mean.size() / 3) / 4;
-    estimated += wp::relative_error(x) * wp::relative_error(x) / 4;
+    std::printf("%s: measured relMSE %g, estimated %g, ratio %.3f\n", sampler, measured, estimated,
+                measured / estimated);
+    if (std::string(sampler) == "independent")
+      EXPECT_NEAR(measured / estimated, 1.0, 0.3)
+          << "measured relMSE " << measured << ", estimated " << estimated;
+    else
+      EXPECT_LE(measured / estimated, 1.3)
+          << "measured relMSE " << measured << ", estimated " << estimated;
   }
-  EXPECT_NEAR(measured / estimated, 1.0, 0.3)
-      << "measured relMSE " << measured << ", estimated " << estimated;
 }
 
 // relative_error's formula on images with known values: one pixel of mean (1, 2, 2) and

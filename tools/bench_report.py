@@ -22,7 +22,7 @@ import sys
 
 STAGES = [
     "generate_camera_rays", "intersect_closest", "shade_surface", "sample_lights",
-    "trace_shadow", "sample_bsdf", "roulette_compact", "accumulate",
+    "trace_shadow", "sample_bsdf", "roulette_compact", "shade", "accumulate",
 ]
 END_TO_END = ["render", "bvh_build", "program_build"]
 # Google Benchmark appends these to a name (UseManualTime, MinTime, Iterations, ...).

@@ -41,7 +41,9 @@ bvh::BuildOptions build_options() {
 
 Wavefront& SceneBench::stages() {
   if (!stages_) {
-    stages_ = std::make_unique<Wavefront>(*env().runtime, scene_, bvh_, bench_settings(false));
+    RenderSettings s = bench_settings(false);
+    s.fused = false;  // the split stages are what the stage benchmarks time, one at a time
+    stages_ = std::make_unique<Wavefront>(*env().runtime, scene_, bvh_, s);
     wave_paths_ = static_cast<std::uint32_t>(stages_->wave_size());
     capture();
   }

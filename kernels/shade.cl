@@ -1,0 +1,26 @@
+/* Stage (fused): everything a path does at a hit, in one kernel, so the surface is resolved once
+ * and stays in registers instead of passing through the path state:
+ * shade_surface (emission, environment, the surface), sample_lights (NEE: a shadow ray into
+ * WP_QUEUE_SHADOW), sample_bsdf (the next ray) and roulette_compact (survivors into queue_out).
+ * From: queue_in with the hit records of intersect_closest.
+ * To:   queue_out (next rays) and WP_QUEUE_SHADOW, which trace_shadow then traces.
+ * It calls the same functions as those four stages, in the same order per path, with the same
+ * random numbers, so the image is the split pipeline's bit for bit (RenderSettings::fused; tested
+ * by RenderKnown.FusedAndSplitShadingAreBitIdentical). Not the default: on PoCL it measured no
+ * faster than the split stages (README, "Fused shading"); it is there for devices where keeping
+ * the surface in registers pays (GPUs: to be measured). */
+#include "stage.h"
+#include "surface.h"
+
+__kernel void shade(WP_STAGE_PARAMS) {
+  WP_STAGE_BIND;
+  uint slot;
+  if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
+  Surface s;
+  if (!shade_hit(&scene, paths, launch, slot, &s)) return;
+#if WP_STRATEGY != WP_STRATEGY_BSDF
+  sample_light_ray(&scene, paths, queues, launch, slot, &s);
+#endif
+  sample_next_ray(paths, queues, launch, slot, &s);
+  roulette(paths, queues, launch, slot);
+}
