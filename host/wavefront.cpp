@@ -149,8 +149,15 @@ void Wavefront::prime_kernels() {
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
   try {
-    for (int i = 0; i < kStageCount; ++i)
-      launch(static_cast<Stage>(i), static_cast<std::uint32_t>(local_size_), p);
+    for (int i = 0; i < kStageCount; ++i) {
+      // Only the stages this pipeline runs: PoCL compiles a kernel at its first launch, and the
+      // other pipeline's kernels would add to the cold build for nothing.
+      const Stage s = static_cast<Stage>(i);
+      const bool split_only = s == Stage::kShadeSurface || s == Stage::kSampleLights ||
+                              s == Stage::kSampleBsdf || s == Stage::kRouletteCompact;
+      if (settings_.fused ? split_only : s == Stage::kShade) continue;
+      launch(s, static_cast<std::uint32_t>(local_size_), p);
+    }
     rt_.queue().finish();
   } catch (const cl::Error& e) {
     rethrow_cl(e, "preparing the kernels on " + rt_.device().name);
