@@ -599,8 +599,10 @@ def cycles_reference(a, scene_json, env):
     h.update(json.dumps([a.width, a.height, a.ref_spp, a.ref_chunks, a.max_depth, a.rr_depth,
                          a.env_intensity, a.env_rotation, versions(["cycles"], env)["cycles"]])
              .encode())
-    with open(os.path.abspath(__file__), "rb") as fh:  # the worker's code is in this file
-        h.update(fh.read())
+    import inspect  # the Cycles worker's code, so that a change to it renders afresh
+    for f in (_cycles_settings, _cycles_camera, _cycles_render, worker_cycles,
+              _cycles_backface_transparent, worker_cycles_gltf):
+        h.update(inspect.getsource(f).encode())
     path = os.path.join(a.work, "reference-cycles-%d-%s.npz" % (a.ref_spp, h.hexdigest()[:16]))
     if not os.path.exists(path):
         spp = a.ref_spp // a.ref_chunks
@@ -972,7 +974,7 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
               "| region | pixels | R | G | B | ± (1 s.e., largest) | relMSE between references |",
               "|---|---|---|---|---|---|---|"]
         for name, c in ref_cmp.items():
-            L.append("| %s | %d | %.4f | %.4f | %.4f | %.4f | %.3g |"
+            L.append("| %s | %d | %.4f | %.4f | %.4f | %.2g | %.3g |"
                      % (name, c["pixels"], *c["ratio"], max(c["se"]), c["rel_mse"]))
         L += ["", "![the two references and their ratio](%s)" % names["references"]]
     _write_with_notes(a, L)
