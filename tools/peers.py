@@ -429,6 +429,10 @@ def parse_args(argv):
                    help="the Markdown page; the chart is written next to it")
     p.add_argument("--quick", action="store_true",
                    help="a smoke run: 64 x 64, spp 4,16, reference 256 spp")
+    p.add_argument("--repeat", type=int, default=1,
+                   help="run the whole sweep this many times (renderer after renderer, the same "
+                        "seeds) and take each run's least wall time: less of other work on "
+                        "a shared machine (default %(default)s)")
     p.add_argument("--pbr", action="store_true",
                    help="render the glTF's own materials (textures, metallic-roughness): Cycles "
                         "loads the file with Blender's glTF importer; wavepath and cycles only, "
@@ -462,6 +466,8 @@ def parse_args(argv):
         p.error("--env needs --pbr (the environment's conversion is verified for that mode only)")
     if a.env and not os.path.isfile(a.env):
         p.error("--env %s: no such file" % a.env)
+    if a.repeat < 1:
+        p.error("--repeat must be at least 1")
     if a.pbr and (a.ref_chunks < 2 or a.ref_spp % a.ref_chunks):
         p.error("--ref-chunks must be at least 2 and divide --ref-spp")
     if not os.access(a.wavepath, os.X_OK):
@@ -749,6 +755,16 @@ def _time_table(a, by):
 
 
 def _runs_table(a, by, ref_word="reference"):
+    if a.repeat > 1:
+        L = ["| renderer | spp | time (s) | times of the %d repetitions (s) | relMSE | image mean "
+             "/ %s |" % (a.repeat, ref_word), "|---|---|---|---|---|---|"]
+        for r in a.renderers:
+            for x in by[r]:
+                L.append("| %s | %d | %.2f | %s | %.3g | %.4f |"
+                         % (LABELS[r], x["spp"], x["seconds"],
+                            ", ".join("%.2f" % t for t in x["all_seconds"]), x["rel_mse"],
+                            x["mean_ratio"]))
+        return L
     L = ["| renderer | spp | time (s) | relMSE | image mean / %s |" % ref_word,
          "|---|---|---|---|---|"]
     for r in a.renderers:
@@ -756,6 +772,15 @@ def _runs_table(a, by, ref_word="reference"):
             L.append("| %s | %d | %.2f | %.3g | %.4f |" % (LABELS[r], x["spp"], x["seconds"],
                                                          x["rel_mse"], x["mean_ratio"]))
     return L
+
+
+def _repeat_sentence(a):
+    if a.repeat == 1:
+        return ""
+    return (" Each run's time is the least of %d: the whole sweep was run %d times, renderer "
+            "after renderer, with the same seeds (so the same images); all times are listed "
+            "under *Every run*. The least is the run least disturbed by other work on the "
+            "machine." % (a.repeat, a.repeat))
 
 
 def _write_with_notes(a, L):
@@ -792,7 +817,8 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
          "compilation, scene load, rendering, writing the image), measured by the script; "
          "relMSE = mean(((x − r)² − var_r) / (r² + 0.01)) against the common reference "
          "(tools/accuracy_lib.py). One unmeasured 1-spp run of each renderer first fills the "
-         "caches kept between processes (wavepath's kernel binary and BVH, Dr.Jit's kernels).", "",
+         "caches kept between processes (wavepath's kernel binary and BVH, Dr.Jit's kernels)."
+         + _repeat_sentence(a), "",
          "The scene is converted exactly (`tools/peers_scene.py`, tested by "
          "`tests/test_peers_scene.py`; the mapping is in `tools/peers.py --help`): triangle "
          "meshes, Lambertian reflectance, the emissive quad as a one-sided area light with the "
@@ -909,7 +935,7 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
          "first), rendering, writing a PFM. Cycles: starting Python and importing `bpy`, "
          "Blender's glTF importer, the scene set-up below, rendering (with Cycles' own BVH "
          "build and texture loading), writing an EXR and reading it back into a NumPy file; "
-         "also after an unmeasured 1-spp run.", "",
+         "also after an unmeasured 1-spp run." + _repeat_sentence(a), "",
          "**Each renderer's error is measured against its own reference** (relMSE = "
          "mean(((x − r)² − var_r) / (r² + 0.01)), tools/accuracy_lib.py, with r and var_r that "
          "renderer's reference and its variance image): the two do not render exactly the same "
@@ -1017,30 +1043,54 @@ def main(argv):
         cimg, cvar, ref_info["cycles"] = cycles_reference(a, scene_json, env)
         refs["cycles"] = (cimg, cvar)
     rows, checks = [], {}
-    load_before = os.getloadavg()[0]
-    for r in a.renderers:
+
+    def score(row, img):
+        """Fills row's relMSE and mean ratio from its image (and checks[] for the largest)."""
+        r, spp = row["renderer"], row["spp"]
         rimg, rvar = refs[r]
-        n = rimg.shape[0] * rimg.shape[1]
-        rmean = rimg.reshape(-1, 3).mean(0)
+        if img.shape != rimg.shape:
+            sys.exit("peers.py: error: %s gave an image of shape %s, not %s"
+                     % (r, img.shape, rimg.shape))
+        st = al.compare(img, np.zeros_like(img), rimg, rvar)
+        row.update(rel_mse=st["rel_mse"], mean_ratio=float(img.mean() / rimg.mean()))
+        log("%-8s %5d spp  %7.2f s%s  relMSE %.4g  mean ratio %.4f"
+            % (r, spp, row["seconds"], " (least of %s)" % " ".join(
+                "%.2f" % x for x in row["all_seconds"]) if a.repeat > 1 else "",
+               row["rel_mse"], row["mean_ratio"]))
+        if spp == max(a.spp):
+            # Var of a channel's image mean, run and reference: sum of pixel variances / n^2.
+            n = rimg.shape[0] * rimg.shape[1]
+            rmean = rimg.reshape(-1, 3).mean(0)
+            v = rvar.reshape(-1, 3).sum(0) / n ** 2
+            se = np.sqrt(v * a.ref_spp / spp + v) / rmean
+            checks[r] = {"spp": spp, "ratio": [float(x) for x in img.reshape(-1, 3).mean(0)
+                                               / rmean], "se": float(se.max())}
+
+    load_before = os.getloadavg()[0]
+    images = {}
+    for r in a.renderers:
         run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
         for k, spp in enumerate(a.spp):
-            seed = 1000 + k
-            t, img = run_one(a, r, spp, seed, scene_json, env)
-            if img.shape != rimg.shape:
-                sys.exit("peers.py: error: %s gave an image of shape %s, not %s"
-                         % (r, img.shape, rimg.shape))
-            st = al.compare(img, np.zeros_like(img), rimg, rvar)
-            ratio = img.reshape(-1, 3).mean(0) / rmean
-            rows.append({"renderer": r, "spp": spp, "seconds": t, "rel_mse": st["rel_mse"],
-                         "mean_ratio": float(img.mean() / rimg.mean())})
-            log("%-8s %5d spp  %7.2f s  relMSE %.4g  mean ratio %.4f"
-                % (r, spp, t, st["rel_mse"], rows[-1]["mean_ratio"]))
-            if spp == max(a.spp):
-                # Var of a channel's image mean, run and reference: sum of pixel variances / n^2.
-                v = rvar.reshape(-1, 3).sum(0) / n ** 2
-                se = np.sqrt(v * a.ref_spp / spp + v) / rmean
-                checks[r] = {"spp": spp, "ratio": [float(x) for x in ratio],
-                             "se": float(se.max())}
+            t, img = run_one(a, r, spp, 1000 + k, scene_json, env)
+            rows.append({"renderer": r, "spp": spp, "seconds": t, "all_seconds": [t]})
+            if a.repeat == 1:
+                score(rows[-1], img)
+            else:
+                images[(r, spp)] = img
+                log("%-8s %5d spp  %7.2f s  (repetition 1 of %d)" % (r, spp, t, a.repeat))
+    # --repeat: the whole sweep again, renderer after renderer, with the same seeds (the same
+    # images: both renderers are deterministic); a run's time is the least of its repetitions.
+    for rep in range(1, a.repeat):
+        for row in rows:
+            t, _ = run_one(a, row["renderer"], row["spp"], 1000 + a.spp.index(row["spp"]),
+                           scene_json, env)
+            row["all_seconds"].append(t)
+            log("%-8s %5d spp  %7.2f s  (repetition %d of %d)"
+                % (row["renderer"], row["spp"], t, rep + 1, a.repeat))
+    if a.repeat > 1:
+        for row in rows:
+            row["seconds"] = min(row["all_seconds"])
+            score(row, images[(row["renderer"], row["spp"])])
     load_after = os.getloadavg()[0]
     with open(os.path.join(a.work, "runs.json"), "w") as f:
         json.dump(rows, f, indent=1)
