@@ -247,6 +247,16 @@ class Cameras(unittest.TestCase):
                 ps.with_camera(path, os.path.join(tmp, "c.glb"), ps.camera(path))
 
 
+class NearestTextures(unittest.TestCase):
+    def test_every_texture_samples_nearest(self):
+        doc = {"samplers": [{"wrapS": 33071}],
+               "textures": [{"sampler": 0, "source": 0}, {"source": 1}]}
+        ps.nearest_textures(doc)
+        self.assertEqual(doc["samplers"], [{"wrapS": 33071, "magFilter": 9728, "minFilter": 9728},
+                                           {"magFilter": 9728, "minFilter": 9728}])
+        self.assertEqual([t["sampler"] for t in doc["textures"]], [0, 1])
+
+
 class Ply(unittest.TestCase):
     def test_round_trip(self):
         mesh = {"positions": [(0.0, 0.5, 1.0), (2.0, 3.0, 4.0), (5.0, 6.0, 7.25)],

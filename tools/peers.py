@@ -445,6 +445,11 @@ def parse_args(argv):
     p.add_argument("--env-rotation", type=float, default=0.0,
                    help="rotation of the map about +Y in degrees, wavepath's --env-rotation "
                         "(default 0)")
+    p.add_argument("--nearest-textures", action="store_true",
+                   help="--pbr, a diagnostic: both render a copy of the file whose samplers are "
+                        "all NEAREST (wavepath looks up the nearest texel; Blender's importer makes "
+                        "the Image Texture nodes interpolation Closest), which takes the order of "
+                        "filtering and sRGB decoding out of the comparison")
     p.add_argument("--ref-chunks", type=int, default=8,
                    help="--pbr: the Cycles reference is the mean of this many runs of "
                         "--ref-spp / N samples with different seeds; their spread gives its "
@@ -468,6 +473,8 @@ def parse_args(argv):
         p.error("--env %s: no such file" % a.env)
     if a.repeat < 1:
         p.error("--repeat must be at least 1")
+    if a.nearest_textures and not a.pbr:
+        p.error("--nearest-textures needs --pbr")
     if a.pbr and (a.ref_chunks < 2 or a.ref_spp % a.ref_chunks):
         p.error("--ref-chunks must be at least 2 and divide --ref-spp")
     if not os.access(a.wavepath, os.X_OK):
@@ -496,11 +503,19 @@ def convert_pbr(a):
     os.makedirs(a.work, exist_ok=True)
     a.render_scene = a.scene
     cam = peers_scene.camera(a.scene)
+    edits, name = [], []
     if cam is None:
         lo, hi = peers_scene.bounds(a.scene)
         cam = peers_scene.framing_camera(lo, hi, a.width / a.height)
-        a.render_scene = os.path.join(a.work, "with_camera" + os.path.splitext(a.scene)[1].lower())
-        peers_scene.with_camera(a.scene, a.render_scene, cam)
+        edits.append(peers_scene.add_camera(cam))
+        name.append("with_camera")
+    if a.nearest_textures:
+        edits.append(peers_scene.nearest_textures)
+        name.append("nearest")
+    if edits:
+        a.render_scene = os.path.join(a.work, "_".join(name)
+                                      + os.path.splitext(a.scene)[1].lower())
+        peers_scene.copy_gltf(a.scene, a.render_scene, edits)
     scene = {"gltf": os.path.abspath(a.render_scene), "camera": cam,
              "env": os.path.abspath(a.env) if a.env else None,
              "env_intensity": a.env_intensity, "env_rotation": a.env_rotation}
@@ -909,6 +924,7 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
     """The page of a --pbr run."""
     by = _by_renderer(a, rows)
     cmd = "tools/peers.py " + " ".join(a.argv)
+    cam_copy = "with_camera" in os.path.basename(a.render_scene)
     env = ("under the environment map `%s` (intensity %g, rotation %g°)"
            % (os.path.relpath(a.env, REPO), a.env_intensity, a.env_rotation) if a.env
            else "with a black background")
@@ -959,7 +975,11 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
          "seeds; the Cornell box page leaves it at Blender's default, on)."
          % ("The file has no camera: both render a copy with wavepath's framing camera "
             "(45° vertical field of view, the bounding sphere fitted) written into it "
-            "(`peers_scene.with_camera`). " if a.render_scene != a.scene else ""), "",
+            "(`peers_scene.with_camera`). " if cam_copy else "")
+         + (" **Both sample every texture at its nearest texel** (--nearest-textures: a copy "
+            "of the file with NEAREST samplers, which Blender's importer turns into Closest "
+            "interpolation), unlike the file's own (linear) filtering." if a.nearest_textures
+            else ""), "",
          "What the two material models do not share: Blender's Principled BSDF reflects "
          "dielectrics with the exact Fresnel equations (IOR 1.5, the importer's \"Specular IOR "
          "Level\" 0.5) and scales the diffuse base by the specular layer's albedo, where glTF "

@@ -17,6 +17,7 @@ Standard library only, so that tests/test_peers_scene.py runs without PyPI.
     peers_scene.framing_camera(lo, hi, aspect)  # wavepath's camera for a file without one
     peers_scene.camera(path)            # the first camera, as scene["camera"]; None without one
     peers_scene.with_camera(path, out, cam)  # a copy (.gltf or .glb) with cam as its camera
+    peers_scene.copy_gltf(path, out, [peers_scene.add_camera(cam), peers_scene.nearest_textures])
 
 Only what the peers can represent exactly is accepted: triangle primitives, Lambertian materials
 (metallic 0, roughness 1, base colour factor and emission without textures, opaque), point lights,
@@ -31,9 +32,10 @@ emissiveStrength as radiance, point light intensity x colour read as W/sr; a tri
 side from which its vertices run counter-clockwise, and a material that is not double-sided is
 invisible from the back (wavepath culls back faces: rays pass through them).
 
-bounds(), framing_camera(), camera() and with_camera() read geometry and cameras only, of any
-glTF (textures and all): they serve the --pbr mode of tools/peers.py, where Cycles imports the
-file itself and both renderers must see it through the same camera.
+bounds(), framing_camera(), camera(), with_camera() and copy_gltf() work on any glTF (textures
+and all): they serve the --pbr mode of tools/peers.py, where Cycles imports the file itself and
+both renderers must see it through the same camera (and, with --nearest-textures, sample its
+textures alike).
 """
 
 import base64
@@ -383,17 +385,15 @@ def _rotation_quaternion(right, up, back):
     return tuple(q)
 
 
-def with_camera(path, out, cam):
-    """Writes a copy of `path` (.gltf or .glb without cameras; `out` the same kind) with `cam` (a
-    dict like scene["camera"]; znear 0.001) as its one camera, on a new root node. Buffers and
-    images the file keeps outside are embedded as data URIs, so `out` can be anywhere."""
+def copy_gltf(path, out, edits):
+    """Writes a copy of `path` (.gltf or .glb; `out` the same kind) with each function of `edits`
+    applied to its JSON document in turn. Buffers and images the file keeps outside are embedded
+    as data URIs, so `out` can be anywhere; a .glb keeps its binary chunk."""
     doc, buffers = _read_document(path)
-    if doc.get("cameras"):
-        raise ValueError("with_camera: %s has cameras already" % path)
     base = os.path.dirname(os.path.abspath(path))
     glb = path.lower().endswith(".glb")
     if glb != out.lower().endswith(".glb"):
-        raise ValueError("with_camera: %s and %s must both be .glb or both .gltf" % (path, out))
+        raise ValueError("copy_gltf: %s and %s must both be .glb or both .gltf" % (path, out))
     for i, b in enumerate(doc.get("buffers", [])):
         if b.get("uri") is not None and not b["uri"].startswith("data:"):
             b["uri"] = ("data:application/octet-stream;base64,"
@@ -406,28 +406,16 @@ def with_camera(path, out, cam):
                 data = f.read()
             mime = im.get("mimeType") or mimetypes.guess_type(uri)[0] or "image/png"
             im["uri"] = "data:%s;base64,%s" % (mime, base64.b64encode(data).decode("ascii"))
-    f, u = _normalize(cam["forward"]), _normalize(cam["up"])
-    right = _normalize((f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
-                        f[0] * u[1] - f[1] * u[0]))
-    up = (right[1] * f[2] - right[2] * f[1], right[2] * f[0] - right[0] * f[2],
-          right[0] * f[1] - right[1] * f[0])
-    persp = {"yfov": cam["yfov"], "znear": 0.001}
-    if cam.get("aspect"):
-        persp["aspectRatio"] = cam["aspect"]
-    doc.setdefault("cameras", []).append({"type": "perspective", "perspective": persp})
-    doc["nodes"].append({"name": "peers_camera", "camera": len(doc["cameras"]) - 1,
-                         "translation": list(cam["position"]),
-                         "rotation": list(_rotation_quaternion(right, up,
-                                                               tuple(-c for c in f)))})
-    doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 1)
+    for edit in edits:
+        edit(doc)
     if not glb:
         with open(out, "w") as fh:
             json.dump(doc, fh)
         return
     bin_chunk = None
-    for b in doc.get("buffers", []):
+    for i, b in enumerate(doc.get("buffers", [])):
         if b.get("uri") is None:
-            bin_chunk = buffers[doc["buffers"].index(b)]
+            bin_chunk = buffers[i]
     js = json.dumps(doc, separators=(",", ":")).encode("utf-8")
     js += b" " * (-len(js) % 4)
     chunks = struct.pack("<II", len(js), 0x4E4F534A) + js
@@ -436,6 +424,49 @@ def with_camera(path, out, cam):
         chunks += struct.pack("<II", len(bin_chunk), 0x004E4942) + bin_chunk
     with open(out, "wb") as fh:
         fh.write(struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks)
+
+
+def add_camera(cam):
+    """An edit for copy_gltf: `cam` (a dict like scene["camera"]; znear 0.001) as the document's
+    one camera, on a new root node; ValueError for a document with cameras."""
+    def edit(doc):
+        if doc.get("cameras"):
+            raise ValueError("add_camera: the file has cameras already")
+        f, u = _normalize(cam["forward"]), _normalize(cam["up"])
+        right = _normalize((f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
+                            f[0] * u[1] - f[1] * u[0]))
+        up = (right[1] * f[2] - right[2] * f[1], right[2] * f[0] - right[0] * f[2],
+              right[0] * f[1] - right[1] * f[0])
+        persp = {"yfov": cam["yfov"], "znear": 0.001}
+        if cam.get("aspect"):
+            persp["aspectRatio"] = cam["aspect"]
+        doc["cameras"] = [{"type": "perspective", "perspective": persp}]
+        doc["nodes"].append({"name": "peers_camera", "camera": 0,
+                             "translation": list(cam["position"]),
+                             "rotation": list(_rotation_quaternion(right, up,
+                                                                   tuple(-c for c in f)))})
+        doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 1)
+    return edit
+
+
+NEAREST = 9728  # glTF's (OpenGL's) NEAREST filter
+
+
+def nearest_textures(doc):
+    """An edit for copy_gltf: every texture samples its nearest texel (magFilter and minFilter
+    NEAREST; a texture without a sampler gets one with glTF's default wrapping, REPEAT)."""
+    samplers = doc.setdefault("samplers", [])
+    for s in samplers:
+        s["magFilter"] = s["minFilter"] = NEAREST
+    for t in doc.get("textures", []):
+        if "sampler" not in t:
+            samplers.append({"magFilter": NEAREST, "minFilter": NEAREST})
+            t["sampler"] = len(samplers) - 1
+
+
+def with_camera(path, out, cam):
+    """copy_gltf(path, out, [add_camera(cam)])."""
+    copy_gltf(path, out, [add_camera(cam)])
 
 
 # ---- Summaries (for the test and the report) -----------------------------------------------------
