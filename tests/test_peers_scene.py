@@ -256,6 +256,11 @@ class NearestTextures(unittest.TestCase):
                                            {"magFilter": 9728, "minFilter": 9728}])
         self.assertEqual([t["sampler"] for t in doc["textures"]], [0, 1])
 
+    def test_no_normal_maps(self):
+        doc = {"materials": [{"normalTexture": {"index": 0}, "name": "a"}, {"name": "b"}]}
+        ps.no_normal_maps(doc)
+        self.assertEqual(doc["materials"], [{"name": "a"}, {"name": "b"}])
+
 
 class Ply(unittest.TestCase):
     def test_round_trip(self):

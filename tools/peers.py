@@ -97,6 +97,9 @@ without a camera is rendered by both from a copy with wavepath's framing camera 
              silhouette (the materials), masks from a wavepath depth-AOV render. A picture of
              the two references and their luminance ratio goes next to the page
              (<page>_references.png).
+  Diagnostics --nearest-textures and --no-normal-maps render copies of the file (nearest-texel
+             samplers; no normal textures) in both, to find where the references' difference
+             comes from.
 
 Each renderer renders the sweep of --spp counts; each run is a separate process and its wall time,
 from start to the image on disk (start-up, kernel or JIT compilation, scene load included), is
@@ -450,6 +453,10 @@ def parse_args(argv):
                         "all NEAREST (wavepath looks up the nearest texel; Blender's importer makes "
                         "the Image Texture nodes interpolation Closest), which takes the order of "
                         "filtering and sRGB decoding out of the comparison")
+    p.add_argument("--no-normal-maps", action="store_true",
+                   help="--pbr, a diagnostic: both render a copy of the file without its normal "
+                        "textures, which takes the tangent frames (each renderer makes its own) "
+                        "out of the comparison")
     p.add_argument("--ref-chunks", type=int, default=8,
                    help="--pbr: the Cycles reference is the mean of this many runs of "
                         "--ref-spp / N samples with different seeds; their spread gives its "
@@ -473,8 +480,8 @@ def parse_args(argv):
         p.error("--env %s: no such file" % a.env)
     if a.repeat < 1:
         p.error("--repeat must be at least 1")
-    if a.nearest_textures and not a.pbr:
-        p.error("--nearest-textures needs --pbr")
+    if (a.nearest_textures or a.no_normal_maps) and not a.pbr:
+        p.error("--nearest-textures and --no-normal-maps need --pbr")
     if a.pbr and (a.ref_chunks < 2 or a.ref_spp % a.ref_chunks):
         p.error("--ref-chunks must be at least 2 and divide --ref-spp")
     if not os.access(a.wavepath, os.X_OK):
@@ -512,6 +519,9 @@ def convert_pbr(a):
     if a.nearest_textures:
         edits.append(peers_scene.nearest_textures)
         name.append("nearest")
+    if a.no_normal_maps:
+        edits.append(peers_scene.no_normal_maps)
+        name.append("no_normal_maps")
     if edits:
         a.render_scene = os.path.join(a.work, "_".join(name)
                                       + os.path.splitext(a.scene)[1].lower())
@@ -954,7 +964,11 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
          "also after an unmeasured 1-spp run." + _repeat_sentence(a), "",
          "**Each renderer's error is measured against its own reference** (relMSE = "
          "mean(((x − r)² − var_r) / (r² + 0.01)), tools/accuracy_lib.py, with r and var_r that "
-         "renderer's reference and its variance image): the two do not render exactly the same "
+         "renderer's reference and its variance image; wavepath's reference is rendered with "
+         "independent samples, as tools/accuracy_lib.py renders references, because only then "
+         "is its variance image the error's, while the sweep runs use wavepath's default "
+         "sampler; Cycles' variance image is the spread of independently seeded runs, right "
+         "for any sampler, and all its runs use its default sampler): the two do not render exactly the same "
          "material model (below), so one common reference would charge the model difference to "
          "one of them as error that no number of samples removes. The comparison is noise "
          "against time: how long each needs to get within a relMSE of its own converged image. "
@@ -979,7 +993,9 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
          + (" **Both sample every texture at its nearest texel** (--nearest-textures: a copy "
             "of the file with NEAREST samplers, which Blender's importer turns into Closest "
             "interpolation), unlike the file's own (linear) filtering." if a.nearest_textures
-            else ""), "",
+            else "")
+         + (" **Both render the model without its normal map** (--no-normal-maps: a copy of "
+            "the file without normal textures)." if a.no_normal_maps else ""), "",
          "What the two material models do not share: Blender's Principled BSDF reflects "
          "dielectrics with the exact Fresnel equations (IOR 1.5, the importer's \"Specular IOR "
          "Level\" 0.5) and scales the diffuse base by the specular layer's albedo, where glTF "
@@ -1000,7 +1016,8 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
     L += ["", "## Each renderer against its own reference: image means", "",
           "Each renderer's largest run against its own reference, per channel. The standard "
           "error of the ratio is estimated from the reference's variance image scaled to the "
-          "run's sample count.", "",
+          "run's sample count (for wavepath's runs, whose default sampler has less error than "
+          "independent samples, an overestimate).", "",
           "| renderer | spp | R | G | B | ± (1 s.e.) |", "|---|---|---|---|---|---|"]
     for r in a.renderers:
         c = checks[r]

@@ -18,6 +18,7 @@ Standard library only, so that tests/test_peers_scene.py runs without PyPI.
     peers_scene.camera(path)            # the first camera, as scene["camera"]; None without one
     peers_scene.with_camera(path, out, cam)  # a copy (.gltf or .glb) with cam as its camera
     peers_scene.copy_gltf(path, out, [peers_scene.add_camera(cam), peers_scene.nearest_textures])
+                                        # (edits: add_camera, nearest_textures, no_normal_maps)
 
 Only what the peers can represent exactly is accepted: triangle primitives, Lambertian materials
 (metallic 0, roughness 1, base colour factor and emission without textures, opaque), point lights,
@@ -34,8 +35,8 @@ invisible from the back (wavepath culls back faces: rays pass through them).
 
 bounds(), framing_camera(), camera(), with_camera() and copy_gltf() work on any glTF (textures
 and all): they serve the --pbr mode of tools/peers.py, where Cycles imports the file itself and
-both renderers must see it through the same camera (and, with --nearest-textures, sample its
-textures alike).
+both renderers must see it through the same camera (and, for the diagnostics --nearest-textures
+and --no-normal-maps, a copy with its textures sampled alike or without its normal maps).
 """
 
 import base64
@@ -462,6 +463,12 @@ def nearest_textures(doc):
         if "sampler" not in t:
             samplers.append({"magFilter": NEAREST, "minFilter": NEAREST})
             t["sampler"] = len(samplers) - 1
+
+
+def no_normal_maps(doc):
+    """An edit for copy_gltf: no material has a normal texture."""
+    for m in doc.get("materials", []):
+        m.pop("normalTexture", None)
 
 
 def with_camera(path, out, cam):
