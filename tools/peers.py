@@ -433,9 +433,10 @@ def parse_args(argv):
     p.add_argument("--quick", action="store_true",
                    help="a smoke run: 64 x 64, spp 4,16, reference 256 spp")
     p.add_argument("--repeat", type=int, default=1,
-                   help="run the whole sweep this many times (renderer after renderer, the same "
-                        "seeds) and take each run's least wall time: less of other work on "
-                        "a shared machine (default %(default)s)")
+                   help="run the sweep this many times (the renderers taking turns at each "
+                        "sample count, the same seeds) and take each run's least wall time: less "
+                        "of other work on a shared machine; the page then also gives CPU times "
+                        "(default %(default)s)")
     p.add_argument("--pbr", action="store_true",
                    help="render the glTF's own materials (textures, metallic-roughness): Cycles "
                         "loads the file with Blender's glTF importer; wavepath and cycles only, "
@@ -492,15 +493,19 @@ def parse_args(argv):
 
 
 def timed(cmd, env=None):
-    """Runs cmd; its wall time in seconds. Exits with its output when it fails."""
+    """Runs cmd; (its wall time in seconds, its output, its CPU time: user + system seconds of
+    the process and the children it waited for). Exits with its output when it fails."""
+    import resource
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           env=env)
     t = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode != 0:
         sys.exit("peers.py: error: %s failed (%d):\n%s" % (" ".join(cmd), proc.returncode,
                                                           proc.stdout[-4000:]))
-    return t, proc.stdout
+    return t, proc.stdout, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
 def convert_pbr(a):
@@ -571,25 +576,26 @@ def convert(a):
 
 
 def run_one(a, renderer, spp, seed, scene_json, env, name=None):
-    """(wall seconds, image top row first)."""
+    """(wall seconds, image top row first, CPU seconds)."""
     import numpy as np
     import accuracy_lib as al
     out = os.path.join(a.work, "%s-%s.npy" % (renderer, name or spp))
     if renderer == "wavepath":
         pfm = out[:-4] + ".pfm"
-        t, _ = timed([a.wavepath, "render", a.render_scene, "--width", str(a.width), "--height",
+        t, _, cpu = timed([a.wavepath, "render", a.render_scene, "--width", str(a.width), "--height",
                       str(a.height), "--spp", str(spp), "--seed", str(seed), "--max-depth",
                       str(a.max_depth), "--rr-depth", str(a.rr_depth), "-o", pfm, "--json", "-q"]
                      + wavepath_scene_args(a))
-        return t, al.read_pfm(pfm)
+        return t, al.read_pfm(pfm), cpu
     job = {"scene": scene_json, "spp": spp, "seed": seed, "width": a.width, "height": a.height,
            "max_depth": a.max_depth, "rr_depth": a.rr_depth, "out": out,
            "variant": a.mitsuba_variant}
     job_path = out[:-4] + ".json"
     with open(job_path, "w") as f:
         json.dump(job, f)
-    t, _ = timed([sys.executable, os.path.abspath(__file__), "--worker", renderer, job_path], env)
-    return t, np.load(out)
+    t, _, cpu = timed([sys.executable, os.path.abspath(__file__), "--worker", renderer, job_path],
+                      env)
+    return t, np.load(out), cpu
 
 
 def reference(a):
@@ -641,7 +647,7 @@ def cycles_reference(a, scene_json, env):
         for k in range(a.ref_chunks):
             log("reference: cycles, run %d of %d, %d spp, %dx%d" % (k + 1, a.ref_chunks, spp,
                                                                     a.width, a.height))
-            t, img = run_one(a, "cycles", spp, 7000 + k, scene_json, env, name="ref%d" % k)
+            t, img, _ = run_one(a, "cycles", spp, 7000 + k, scene_json, env, name="ref%d" % k)
             runs.append(img)
             seconds += t
         runs = np.array(runs)
@@ -759,15 +765,15 @@ def _by_renderer(a, rows):
             for r in a.renderers}
 
 
-def _time_table(a, by):
-    """The time-to-target table's lines."""
+def _time_table(a, by, key="seconds"):
+    """The time-to-target table's lines (from each run's `key`: wall or CPU seconds)."""
     head = "| relMSE target |" + "".join(" %s |" % LABELS[r] for r in a.renderers)
     peers = [r for r in a.renderers if r != "wavepath"]
     if "wavepath" in a.renderers:
         head += "".join(" %s / wavepath |" % LABELS[r].split(" (")[0] for r in peers)
     L = [head, "|" + "---|" * (head.count("|") - 1)]
     for target in a.targets:
-        tt = {r: time_to_target([(x["seconds"], x["rel_mse"]) for x in by[r]], target)
+        tt = {r: time_to_target([(x[key], x["rel_mse"]) for x in by[r]], target)
               for r in a.renderers}
         line = "| %g |" % target + "".join(" %s |" % fmt_t(*tt[r]) for r in a.renderers)
         if "wavepath" in a.renderers:
@@ -781,14 +787,14 @@ def _time_table(a, by):
 
 def _runs_table(a, by, ref_word="reference"):
     if a.repeat > 1:
-        L = ["| renderer | spp | time (s) | times of the %d repetitions (s) | relMSE | image mean "
-             "/ %s |" % (a.repeat, ref_word), "|---|---|---|---|---|---|"]
+        L = ["| renderer | spp | time (s) | times of the %d repetitions (s) | CPU time (s) | "
+             "relMSE | image mean / %s |" % (a.repeat, ref_word), "|---|---|---|---|---|---|---|"]
         for r in a.renderers:
             for x in by[r]:
-                L.append("| %s | %d | %.2f | %s | %.3g | %.4f |"
+                L.append("| %s | %d | %.2f | %s | %.2f | %.3g | %.4f |"
                          % (LABELS[r], x["spp"], x["seconds"],
-                            ", ".join("%.2f" % t for t in x["all_seconds"]), x["rel_mse"],
-                            x["mean_ratio"]))
+                            ", ".join("%.2f" % t for t in x["all_seconds"]), x["cpu_seconds"],
+                            x["rel_mse"], x["mean_ratio"]))
         return L
     L = ["| renderer | spp | time (s) | relMSE | image mean / %s |" % ref_word,
          "|---|---|---|---|---|"]
@@ -802,10 +808,12 @@ def _runs_table(a, by, ref_word="reference"):
 def _repeat_sentence(a):
     if a.repeat == 1:
         return ""
-    return (" Each run's time is the least of %d: the whole sweep was run %d times, renderer "
-            "after renderer, with the same seeds (so the same images); all times are listed "
-            "under *Every run*. The least is the run least disturbed by other work on the "
-            "machine." % (a.repeat, a.repeat))
+    return (" Each run's time is the least of %d: the sweep was run %d times, the renderers "
+            "taking turns at each sample count, with the same seeds (so the same images); all "
+            "times are listed under *Every run*, with the least CPU time (user + system seconds "
+            "of the process and its children), which other work on the machine changes much "
+            "less than the wall time. The least wall time is the run least disturbed by other "
+            "work." % (a.repeat, a.repeat))
 
 
 def _write_with_notes(a, L):
@@ -1011,6 +1019,11 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
          "the largest run as relMSE ∝ 1/time; `≤`: reached by the smallest run. The ratio is "
          "Cycles' time over wavepath's (above 1: wavepath is faster).", ""]
     L += _time_table(a, by)
+    if a.repeat > 1:
+        L += ["", "The same by CPU time (user + system seconds, the least of the repetitions): "
+              "the work each process did on the 2 cores, whatever else was running; with both "
+              "cores busy all along it would be about twice the wall time.", ""]
+        L += _time_table(a, by, "cpu_seconds")
     L += ["", "## Every run", "", "relMSE and image mean against the renderer's own reference.",
           ""] + _runs_table(a, by, "own reference")
     L += ["", "## Each renderer against its own reference: image means", "",
@@ -1104,29 +1117,36 @@ def main(argv):
                                                / rmean], "se": float(se.max())}
 
     load_before = os.getloadavg()[0]
-    images = {}
-    for r in a.renderers:
-        run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
-        for k, spp in enumerate(a.spp):
-            t, img = run_one(a, r, spp, 1000 + k, scene_json, env)
-            rows.append({"renderer": r, "spp": spp, "seconds": t, "all_seconds": [t]})
-            if a.repeat == 1:
+    if a.repeat == 1:
+        for r in a.renderers:
+            run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
+            for k, spp in enumerate(a.spp):
+                t, img, cpu = run_one(a, r, spp, 1000 + k, scene_json, env)
+                rows.append({"renderer": r, "spp": spp, "seconds": t, "cpu_seconds": cpu})
                 score(rows[-1], img)
-            else:
-                images[(r, spp)] = img
-                log("%-8s %5d spp  %7.2f s  (repetition 1 of %d)" % (r, spp, t, a.repeat))
-    # --repeat: the whole sweep again, renderer after renderer, with the same seeds (the same
-    # images: both renderers are deterministic); a run's time is the least of its repetitions.
-    for rep in range(1, a.repeat):
-        for row in rows:
-            t, _ = run_one(a, row["renderer"], row["spp"], 1000 + a.spp.index(row["spp"]),
-                           scene_json, env)
-            row["all_seconds"].append(t)
-            log("%-8s %5d spp  %7.2f s  (repetition %d of %d)"
-                % (row["renderer"], row["spp"], t, rep + 1, a.repeat))
-    if a.repeat > 1:
+    else:
+        # --repeat: every renderer's warm-up, then the sweep N times, the renderers taking turns
+        # at each sample count (so that both meet much the same other work), with the same
+        # seeds (the same images: both renderers are deterministic); a run's time is the least
+        # of its repetitions.
+        for r in a.renderers:
+            run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
+        rows = [{"renderer": r, "spp": spp, "all_seconds": [], "all_cpu_seconds": []}
+                for r in a.renderers for spp in a.spp]
+        row_of = {(x["renderer"], x["spp"]): x for x in rows}
+        images = {}
+        for rep in range(a.repeat):
+            for k, spp in enumerate(a.spp):
+                for r in a.renderers:
+                    t, img, cpu = run_one(a, r, spp, 1000 + k, scene_json, env)
+                    row_of[(r, spp)]["all_seconds"].append(t)
+                    row_of[(r, spp)]["all_cpu_seconds"].append(cpu)
+                    images.setdefault((r, spp), img)
+                    log("%-8s %5d spp  %7.2f s  CPU %7.2f s  (repetition %d of %d)"
+                        % (r, spp, t, cpu, rep + 1, a.repeat))
         for row in rows:
             row["seconds"] = min(row["all_seconds"])
+            row["cpu_seconds"] = min(row["all_cpu_seconds"])
             score(row, images[(row["renderer"], row["spp"])])
     load_after = os.getloadavg()[0]
     with open(os.path.join(a.work, "runs.json"), "w") as f:
