@@ -508,6 +508,32 @@ def timed(cmd, env=None):
     return t, proc.stdout, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
+def cpu_snapshot():
+    """(busy, steal, own) CPU seconds so far: the machine's busy time over all cores (user, nice,
+    system, irq, softirq in /proc/stat), the time the hypervisor took (steal), and this script's
+    own (this process and the children it waited for); None where /proc/stat is missing."""
+    import resource
+    try:
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:9]]
+    except (OSError, ValueError):
+        return None
+    tick = os.sysconf("SC_CLK_TCK")
+    own = sum(getattr(resource.getrusage(w), k) for w in (resource.RUSAGE_SELF,
+                                                          resource.RUSAGE_CHILDREN)
+              for k in ("ru_utime", "ru_stime"))
+    return (v[0] + v[1] + v[2] + v[5] + v[6]) / tick, v[7] / tick, own
+
+
+def other_work(before, after, wall):
+    """{"other", "steal", "capacity"} CPU seconds between two cpu_snapshot()s `wall` seconds
+    apart: busy time not this script's, hypervisor steal, and cores x wall."""
+    if before is None or after is None:
+        return None
+    return {"other": max(0.0, (after[0] - before[0]) - (after[2] - before[2])),
+            "steal": after[1] - before[1], "capacity": wall * (os.cpu_count() or 1)}
+
+
 def convert_pbr(a):
     """--pbr: the scene as Cycles' worker reads it (the glTF itself, the camera, the environment).
     A file without a camera is rendered by both from a copy (--work/with_camera.glb or .gltf)
@@ -938,7 +964,7 @@ def references_image(a, refs, path):
     plt.close(fig)
 
 
-def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
+def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
     """The page of a --pbr run."""
     by = _by_renderer(a, rows)
     cmd = "tools/peers.py " + " ".join(a.argv)
@@ -955,12 +981,16 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, load):
          "Written by `tools/peers.py --pbr` (see its `--help`); regenerate with", "",
          "    " + cmd, "",
          "Scene `%s` %s, %d × %d, max depth %d scattering events, Russian roulette after %d "
-         "(wavepath's); sweep %s samples per pixel; references: %s. Machine: %s, %d cores, load "
-         "average %.1f before the sweep and %.1f after it (1 minute; anything above 0 is other "
-         "work sharing the cores, which slows whichever renderer runs then); both render on the "
-         "CPU. Versions: %s."
+         "(wavepath's); sweep %s samples per pixel; references: %s. Machine: %s, %d cores%s; "
+         "both render on the CPU. Versions: %s."
          % (os.path.relpath(a.scene, REPO), env, a.width, a.height, a.max_depth, a.rr_depth,
-            ", ".join(map(str, a.spp)), refs, _cpu_name(), os.cpu_count(), load[0], load[1],
+            ", ".join(map(str, a.spp)), refs, _cpu_name(), os.cpu_count(),
+            "" if other is None else
+            "; other work used %.0f%% of the machine's CPU time during the sweep (%.0f of %.0f "
+            "core-seconds: its busy time in /proc/stat less this script's own processes; "
+            "whichever renderer runs then is slowed), the hypervisor took %.1f%% (steal)"
+            % (100 * other["other"] / other["capacity"], other["other"], other["capacity"],
+               100 * other["steal"] / other["capacity"]),
             "; ".join("%s: %s" % kv for kv in vers.items())), "",
          "Time is the wall time of each render's whole process, measured by the script from "
          "its start to the image on disk. wavepath: start-up, loading the glTF and decoding its "
@@ -1117,6 +1147,7 @@ def main(argv):
                                                / rmean], "se": float(se.max())}
 
     load_before = os.getloadavg()[0]
+    cpu_before, wall_before = cpu_snapshot(), time.perf_counter()
     if a.repeat == 1:
         for r in a.renderers:
             run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
@@ -1149,6 +1180,7 @@ def main(argv):
             row["cpu_seconds"] = min(row["all_cpu_seconds"])
             score(row, images[(row["renderer"], row["spp"])])
     load_after = os.getloadavg()[0]
+    other = other_work(cpu_before, cpu_snapshot(), time.perf_counter() - wall_before)
     with open(os.path.join(a.work, "runs.json"), "w") as f:
         json.dump(rows, f, indent=1)
     base = os.path.splitext(a.out)[0]
@@ -1168,7 +1200,7 @@ def main(argv):
                 log("references, %-10s Cycles / wavepath %s  relMSE %.3g"
                     % (name, " ".join("%.4f" % x for x in c["ratio"]), c["rel_mse"]))
         write_doc_pbr(a, rows, checks, ref_info, ref_cmp, versions(a.renderers, env), names,
-                      (load_before, load_after))
+                      other)
     else:
         write_doc(a, rows, checks, ref_seconds, versions(a.renderers, env),
                   os.path.relpath(chart_path, page_dir), (load_before, load_after))
