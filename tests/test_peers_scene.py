@@ -11,7 +11,8 @@ direction and field of view; every wall triangle faces into the box; the materia
 and the Lambertian copy (specularFactor 0, all else equal). Node transforms (a parent
 with translation, rotation and scale, a child with a mirroring matrix, whose winding must be
 reversed) on a scene written with scenes/gltf_builder.py as .glb; refusals of what the peers
-cannot represent; the PLY writer read back.
+cannot represent; the PLY writer read back; for --pbr, world-space bounds, wavepath's framing
+camera, and the copy with that camera written in (.glb and .gltf, read back).
 """
 
 import math
@@ -174,6 +175,91 @@ class Refusals(unittest.TestCase):
             b.write(path)
             with self.assertRaisesRegex(ps.ConversionError, "only point lights"):
                 ps.load(path)
+
+
+class Cameras(unittest.TestCase):
+    """bounds, framing_camera, camera and with_camera (the --pbr mode's camera for files without
+    one)."""
+
+    def scene(self, path, camera=False):
+        b = gb.GltfBuilder()
+        m = b.material("m", base_color=(0.5, 0.5, 0.5), metallic=1.0, roughness=0.3)
+        pos, _, idx = gb.box((0.0, 0.0, 0.0), (1.0, 2.0, 3.0))
+        b.node("box", mesh=b.mesh("box", pos, idx, m), translation=(1.0, 0.0, -1.0))
+        if camera:
+            b.node("camera", camera=b.perspective_camera(0.5, 0.01), translation=(0, 0, 5))
+        b.write(path)
+
+    def assertClose(self, a, b, tol=1e-9):
+        self.assertEqual(len(a), len(b))
+        for x, y in zip(a, b):
+            self.assertAlmostEqual(x, y, delta=tol, msg="%s != %s" % (a, b))
+
+    def test_bounds_in_world_space(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.glb")
+            self.scene(path)
+            lo, hi = ps.bounds(path)
+        self.assertClose(lo, (1.0, 0.0, -1.0))
+        self.assertClose(hi, (2.0, 2.0, 2.0))
+
+    def test_framing_camera_is_wavepaths(self):
+        # host/gltf_loader.cpp: 45 degrees, from +Z and 15 degrees above, the bounding sphere
+        # (radius half the diagonal) fitting the tighter half-angle.
+        lo, hi = (0.0, 0.0, 0.0), (2.0, 2.0, 2.0)
+        e = math.radians(15.0)
+        for aspect, half in ((1.0, math.radians(22.5)),
+                             (0.5, math.atan(math.tan(math.radians(22.5)) * 0.5))):
+            cam = ps.framing_camera(lo, hi, aspect)
+            d = math.sqrt(3.0) / math.sin(half)
+            self.assertClose(cam["position"], (1.0, 1.0 + d * math.sin(e), 1.0 + d * math.cos(e)))
+            self.assertClose(cam["forward"], (0.0, -math.sin(e), -math.cos(e)))
+            self.assertClose(cam["up"], (0.0, math.cos(e), -math.sin(e)))
+            self.assertAlmostEqual(cam["yfov"], math.pi / 4)
+            self.assertEqual(cam["aspect"], aspect)
+
+    def test_with_camera_round_trip(self):
+        for ext in (".glb", ".gltf"):
+            with tempfile.TemporaryDirectory() as tmp:
+                path, out = os.path.join(tmp, "t" + ext), os.path.join(tmp, "c" + ext)
+                self.scene(path)
+                self.assertIsNone(ps.camera(path))
+                cam = ps.framing_camera(*ps.bounds(path), 1.5)
+                ps.with_camera(path, out, cam)
+                os.remove(path)  # the copy stands alone
+                if ext == ".gltf":
+                    for f in os.listdir(tmp):
+                        if f != "c.gltf":
+                            os.remove(os.path.join(tmp, f))
+                got = ps.camera(out)
+                for k in ("position", "forward", "up"):
+                    self.assertClose(got[k], cam[k], 1e-12)
+                self.assertEqual(got["yfov"], cam["yfov"])
+                self.assertEqual(got["aspect"], 1.5)
+                self.assertClose(ps.bounds(out)[0], (1.0, 0.0, -1.0))
+
+    def test_with_camera_refuses_a_file_with_cameras(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.glb")
+            self.scene(path, camera=True)
+            self.assertEqual(ps.camera(path)["position"], (0.0, 0.0, 5.0))
+            with self.assertRaisesRegex(ValueError, "has cameras already"):
+                ps.with_camera(path, os.path.join(tmp, "c.glb"), ps.camera(path))
+
+
+class NearestTextures(unittest.TestCase):
+    def test_every_texture_samples_nearest(self):
+        doc = {"samplers": [{"wrapS": 33071}],
+               "textures": [{"sampler": 0, "source": 0}, {"source": 1}]}
+        ps.nearest_textures(doc)
+        self.assertEqual(doc["samplers"], [{"wrapS": 33071, "magFilter": 9728, "minFilter": 9728},
+                                           {"magFilter": 9728, "minFilter": 9728}])
+        self.assertEqual([t["sampler"] for t in doc["textures"]], [0, 1])
+
+    def test_no_normal_maps(self):
+        doc = {"materials": [{"normalTexture": {"index": 0}, "name": "a"}, {"name": "b"}]}
+        ps.no_normal_maps(doc)
+        self.assertEqual(doc["materials"], [{"name": "a"}, {"name": "b"}])
 
 
 class Ply(unittest.TestCase):

@@ -4,6 +4,8 @@ the project's own glTF scenes, converted exactly; error against whole-process ti
 Markdown page with a chart and a table of time-to-target ratios.
 
     tools/peers.py --scene scenes/cornell_box.gltf --width 128 --height 128 --out docs/peers.md
+    tools/peers.py --pbr --renderers wavepath,cycles --scene MODEL.glb --env MAP.hdr \
+        --out docs/peers_helmet.md
 
 Run `tools/peers.py --help` for the options. Not part of tools/test.sh: the peers come from PyPI
 (`mitsuba`, `bpy`, with numpy and matplotlib) into a virtual environment the script creates
@@ -66,17 +68,50 @@ wavepath too: all three render the same purely Lambertian scene.
              transform Standard, exposure 0 (the EXR is scene-linear anyway). Point lights are
              refused (Blender's watt convention is not verified here).
 
+PBR MODE (--pbr; --renderers wavepath,cycles): the scene is not converted but given to each
+renderer as the glTF file it is, textures and metallic-roughness materials included, optionally
+under an environment map (--env, --env-intensity, --env-rotation, wavepath's options). A file
+without a camera is rendered by both from a copy with wavepath's framing camera written into it
+(tools/peers_scene.py: bounds, framing_camera, with_camera; --work/with_camera.glb).
+  Cycles     bpy.ops.import_scene.gltf (Blender's glTF importer, shipped with bpy): Principled
+             BSDFs, set to single-scatter GGX (`distribution` GGX; Blender's default is
+             multiscatter) with subsurface weight 0; a material the importer marks as
+             backface-culled (glTF doubleSided false) gets the Mix Shader with a Transparent BSDF
+             on back faces described above. World: an Environment Texture of the map (colour
+             space Linear Rec.709, interpolation Closest: wavepath looks up the texel a direction
+             falls in) times --env-intensity, its direction turned by a Mapping node (type Point,
+             rotation about Z of -(90 + --env-rotation) degrees): the importer turns glTF's +Y
+             up into Blender's +Z up, and Blender's equirectangular map has its centre at +X
+             where wavepath's has it at glTF's -Z (Blender's +Y). Black world without --env. The
+             camera as above, its vectors turned with the importer's axes. Light tree off.
+             Settings otherwise as above.
+  Errors     The two do not render the same material model (Blender's Principled BSDF is not
+             glTF's BRDF: exact dielectric Fresnel and albedo-scaled diffuse, F82 metals,
+             MikkTSpace tangents), so each renderer's relMSE is measured against its own
+             reference: wavepath's as above, Cycles' the mean of --ref-chunks runs of --ref-spp /
+             --ref-chunks samples with seeds 7000, 7001, ..., with the runs' per-pixel sample
+             variance over their number as its variance image (cached in --work). The page also
+             compares the two references: the ratio of their image means per channel and their
+             relMSE beyond both variance images, over all pixels, over the background pixels
+             (environment only: tests its conversion) and over the pixels inside the model's
+             silhouette (the materials), masks from a wavepath depth-AOV render. A picture of
+             the two references and their luminance ratio goes next to the page
+             (<page>_references.png).
+  Diagnostics --nearest-textures and --no-normal-maps render copies of the file (nearest-texel
+             samplers; no normal textures) in both, to find where the references' difference
+             comes from.
+
 Each renderer renders the sweep of --spp counts; each run is a separate process and its wall time,
 from start to the image on disk (start-up, kernel or JIT compilation, scene load included), is
 measured by this script. One unmeasured 1-spp run of each renderer first fills the caches that
 persist between processes (wavepath's kernel binary and BVH caches, Dr.Jit's kernel cache), so that
 no measured run pays a one-off compilation. relMSE is tools/accuracy_lib.py's: mean(((x - r)^2 -
-var_r) / (r^2 + 0.01)) against one common reference, a wavepath render of --ref-spp samples with its
-variance image (so the reference's own noise is subtracted). The conversion is checked by the image
-means: each peer's largest run against the reference, per channel (their ratio must be 1 within
-noise; a wrong conversion also shows as relMSE that stops falling). Time to reach a relMSE target:
-interpolated linearly on log-log between the two runs around it; beyond the last run, extrapolated
-as relMSE ~ 1 / time from it (marked ~).
+var_r) / (r^2 + 0.01)) against one common reference (without --pbr), a wavepath render of --ref-spp
+samples with its variance image (so the reference's own noise is subtracted). The conversion is
+checked by the image means: each peer's largest run against the reference, per channel (their
+ratio must be 1 within noise; a wrong conversion also shows as relMSE that stops falling). Time
+to reach a relMSE target: interpolated linearly on log-log between the two runs around it; beyond
+the last run, extrapolated as relMSE ~ 1 / time from it (marked ~).
 
 The page (--out) is rewritten on every run except for what follows its line
 "<!-- notes: kept when the page is regenerated -->": hand-written notes on the figures.
@@ -197,12 +232,8 @@ def _cycles_material(bpy, mat):
     return m
 
 
-def worker_cycles(job, scene):
-    import bpy
-    import numpy as np
-    if scene["point_lights"]:
-        raise SystemExit("peers.py: error: Cycles: point lights are not converted (Blender's "
-                         "point light power convention is not verified here)")
+def _cycles_settings(bpy, job):
+    """An empty Blender scene with the Cycles settings of the --help text; returns it."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
@@ -228,6 +259,54 @@ def worker_cycles(job, scene):
     sc.view_settings.look = "None"
     sc.view_settings.exposure = 0.0
     sc.view_settings.gamma = 1.0
+    return sc
+
+
+def _cycles_camera(bpy, sc, cam, axes):
+    """The camera `cam` (scene["camera"]) as the scene's camera; `axes` maps a glTF vector to
+    Blender's (identity for meshes built here, glTF's +Y up to Blender's +Z up for imports)."""
+    data = bpy.data.cameras.new("camera")
+    data.type = "PERSP"
+    data.sensor_fit = "VERTICAL"
+    data.angle_y = cam["yfov"]
+    data.clip_start = 1e-3
+    data.clip_end = 1e4
+    ob = bpy.data.objects.new("camera", data)
+    f, u, p = axes(cam["forward"]), axes(cam["up"]), axes(cam["position"])
+    right = (f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2], f[0] * u[1] - f[1] * u[0])
+    from mathutils import Matrix
+    ob.matrix_world = Matrix([[right[i], u[i], -f[i], p[i]] for i in range(3)]
+                             + [[0.0, 0.0, 0.0, 1.0]])
+    sc.collection.objects.link(ob)
+    sc.camera = ob
+
+
+def _cycles_render(bpy, sc, job):
+    """Renders, and saves the image (top row first) as job["out"] (.npy)."""
+    import numpy as np
+    exr = job["out"][:-4] + ".exr"
+    sc.render.image_settings.file_format = "OPEN_EXR"
+    sc.render.image_settings.color_depth = "32"
+    sc.render.image_settings.color_mode = "RGB"
+    sc.render.filepath = exr
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(exr)
+    pix = np.empty(job["width"] * job["height"] * img.channels, dtype=np.float32)
+    img.pixels.foreach_get(pix)
+    pix = pix.reshape(job["height"], job["width"], img.channels)[::-1, :, :3]  # rows bottom-up
+    np.save(job["out"], pix.astype(np.float64))
+    os.remove(exr)
+
+
+def worker_cycles(job, scene):
+    import bpy
+    if scene.get("gltf"):
+        worker_cycles_gltf(bpy, job, scene)
+        return
+    if scene["point_lights"]:
+        raise SystemExit("peers.py: error: Cycles: point lights are not converted (Blender's "
+                         "point light power convention is not verified here)")
+    sc = _cycles_settings(bpy, job)
     world = bpy.data.worlds.new("black")
     world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
@@ -242,35 +321,74 @@ def worker_cycles(job, scene):
         me.update()
         ob = bpy.data.objects.new(mesh["name"], me)
         sc.collection.objects.link(ob)
+    _cycles_camera(bpy, sc, scene["camera"], lambda v: v)
+    _cycles_render(bpy, sc, job)
 
-    cam = scene["camera"]
-    data = bpy.data.cameras.new("camera")
-    data.type = "PERSP"
-    data.sensor_fit = "VERTICAL"
-    data.angle_y = cam["yfov"]
-    data.clip_start = 1e-3
-    data.clip_end = 1e4
-    ob = bpy.data.objects.new("camera", data)
-    f, u = cam["forward"], cam["up"]
-    right = (f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2], f[0] * u[1] - f[1] * u[0])
-    from mathutils import Matrix
-    ob.matrix_world = Matrix([[right[i], u[i], -f[i], cam["position"][i]] for i in range(3)]
-                             + [[0.0, 0.0, 0.0, 1.0]])
-    sc.collection.objects.link(ob)
-    sc.camera = ob
 
-    exr = job["out"][:-4] + ".exr"
-    sc.render.image_settings.file_format = "OPEN_EXR"
-    sc.render.image_settings.color_depth = "32"
-    sc.render.image_settings.color_mode = "RGB"
-    sc.render.filepath = exr
-    bpy.ops.render.render(write_still=True)
-    img = bpy.data.images.load(exr)
-    pix = np.empty(job["width"] * job["height"] * img.channels, dtype=np.float32)
-    img.pixels.foreach_get(pix)
-    pix = pix.reshape(job["height"], job["width"], img.channels)[::-1, :, :3]  # rows bottom-up
-    np.save(job["out"], pix.astype(np.float64))
-    os.remove(exr)
+def _cycles_backface_transparent(m):
+    """Makes back faces of material m a Transparent BSDF (wavepath culls the back faces of a
+    material that is not double-sided: rays pass through them)."""
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    outs = [n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    for out in outs:
+        if not out.inputs["Surface"].is_linked:
+            continue
+        shader = out.inputs["Surface"].links[0].from_socket
+        geometry = nodes.new("ShaderNodeNewGeometry")
+        transparent = nodes.new("ShaderNodeBsdfTransparent")
+        mix = nodes.new("ShaderNodeMixShader")
+        links.new(geometry.outputs["Backfacing"], mix.inputs[0])
+        links.new(shader, mix.inputs[1])
+        links.new(transparent.outputs[0], mix.inputs[2])
+        links.new(mix.outputs[0], out.inputs["Surface"])
+
+
+def worker_cycles_gltf(bpy, job, scene):
+    """--pbr: the glTF through Blender's own importer (io_scene_gltf2), Principled BSDFs set to
+    single-scatter GGX, the environment map as the world (see the --help text)."""
+    import math
+    sc = _cycles_settings(bpy, job)
+    # Measured on DamagedHelmet under empty_warehouse_01_1k.hdr, 256 x 256, 256 spp, 3 seeds:
+    # without the light tree Cycles took 5.6 s against 6.8 s, at relMSE 2.6e-3 against 3.0e-3.
+    sc.cycles.use_light_tree = False
+    bpy.ops.import_scene.gltf(filepath=scene["gltf"])
+    sc = bpy.context.scene
+    for m in bpy.data.materials:
+        if not m.use_nodes:
+            continue
+        for n in m.node_tree.nodes:
+            if n.bl_idname == "ShaderNodeBsdfPrincipled":
+                n.distribution = "GGX"  # Blender's default is multiscatter GGX
+                n.inputs["Subsurface Weight"].default_value = 0.0
+        if m.use_backface_culling:  # the importer's mark of a glTF material not double-sided
+            _cycles_backface_transparent(m)
+    world = bpy.data.worlds.new("env")
+    world.use_nodes = True
+    nt = world.node_tree
+    bg = nt.nodes["Background"]
+    if scene.get("env"):
+        env = nt.nodes.new("ShaderNodeTexEnvironment")
+        env.image = bpy.data.images.load(scene["env"])
+        env.image.colorspace_settings.name = "Linear Rec.709"
+        env.interpolation = "Closest"  # wavepath: the texel the direction falls in
+        env.projection = "EQUIRECTANGULAR"
+        coord = nt.nodes.new("ShaderNodeTexCoord")
+        mapping = nt.nodes.new("ShaderNodeMapping")
+        mapping.vector_type = "POINT"
+        # wavepath's map centre is glTF's -Z, Blender's +X: 90 degrees about the up axis, plus
+        # --env-rotation (wavepath turns the map by R about +Y; the lookup turns by -R).
+        mapping.inputs["Rotation"].default_value = (
+            0.0, 0.0, -math.radians(scene["env_rotation"] + 90.0))
+        nt.links.new(coord.outputs["Generated"], mapping.inputs["Vector"])
+        nt.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+        nt.links.new(env.outputs["Color"], bg.inputs["Color"])
+        bg.inputs["Strength"].default_value = scene["env_intensity"]
+    else:
+        bg.inputs["Color"].default_value = tuple(scene["env_color"]) + (1.0,)
+        bg.inputs["Strength"].default_value = 1.0
+    sc.world = world
+    _cycles_camera(bpy, sc, scene["camera"], lambda v: (v[0], -v[2], v[1]))
+    _cycles_render(bpy, sc, job)
 
 
 def worker_main(renderer, job_path):
@@ -293,7 +411,8 @@ def parse_args(argv):
     p.add_argument("--spp", default="4,16,64,256",
                    help="comma-separated sample counts of the sweep (default %(default)s)")
     p.add_argument("--ref-spp", type=int, default=2048,
-                   help="samples per pixel of the wavepath reference (default %(default)s)")
+                   help="samples per pixel of the wavepath reference (and, with --pbr, of Cycles' "
+                        "own) (default %(default)s)")
     p.add_argument("--max-depth", type=int, default=12,
                    help="scattering events, wavepath's --max-depth (default %(default)s)")
     p.add_argument("--rr-depth", type=int, default=5,
@@ -313,6 +432,36 @@ def parse_args(argv):
                    help="the Markdown page; the chart is written next to it")
     p.add_argument("--quick", action="store_true",
                    help="a smoke run: 64 x 64, spp 4,16, reference 256 spp")
+    p.add_argument("--repeat", type=int, default=1,
+                   help="run the sweep this many times (the renderers taking turns at each "
+                        "sample count, the same seeds) and take each run's least wall time: less "
+                        "of other work on a shared machine; the page then also gives CPU times "
+                        "(default %(default)s)")
+    p.add_argument("--pbr", action="store_true",
+                   help="render the glTF's own materials (textures, metallic-roughness): Cycles "
+                        "loads the file with Blender's glTF importer; wavepath and cycles only, "
+                        "each measured against its own reference (see PBR MODE below)")
+    p.add_argument("--env", metavar="PATH",
+                   help="equirectangular environment map (.hdr, .exr) lighting the scene, "
+                        "wavepath's --env (with --pbr only)")
+    p.add_argument("--env-intensity", type=float, default=1.0,
+                   help="scale of the environment map, wavepath's --env-intensity (default 1)")
+    p.add_argument("--env-rotation", type=float, default=0.0,
+                   help="rotation of the map about +Y in degrees, wavepath's --env-rotation "
+                        "(default 0)")
+    p.add_argument("--nearest-textures", action="store_true",
+                   help="--pbr, a diagnostic: both render a copy of the file whose samplers are "
+                        "all NEAREST (wavepath looks up the nearest texel; Blender's importer makes "
+                        "the Image Texture nodes interpolation Closest), which takes the order of "
+                        "filtering and sRGB decoding out of the comparison")
+    p.add_argument("--no-normal-maps", action="store_true",
+                   help="--pbr, a diagnostic: both render a copy of the file without its normal "
+                        "textures, which takes the tangent frames (each renderer makes its own) "
+                        "out of the comparison")
+    p.add_argument("--ref-chunks", type=int, default=8,
+                   help="--pbr: the Cycles reference is the mean of this many runs of "
+                        "--ref-spp / N samples with different seeds; their spread gives its "
+                        "variance image (default %(default)s)")
     a = p.parse_args(argv)
     if a.quick:
         a.width, a.height, a.spp, a.ref_spp = 64, 64, "4,16", 256
@@ -324,6 +473,18 @@ def parse_args(argv):
     bad = [r for r in a.renderers if r not in RENDERERS]
     if bad:
         p.error("unknown renderer(s) %s" % ", ".join(bad))
+    if a.pbr and "mitsuba" in a.renderers:
+        p.error("--pbr: Mitsuba is not converted for glTF materials (--renderers wavepath,cycles)")
+    if a.env and not a.pbr:
+        p.error("--env needs --pbr (the environment's conversion is verified for that mode only)")
+    if a.env and not os.path.isfile(a.env):
+        p.error("--env %s: no such file" % a.env)
+    if a.repeat < 1:
+        p.error("--repeat must be at least 1")
+    if (a.nearest_textures or a.no_normal_maps) and not a.pbr:
+        p.error("--nearest-textures and --no-normal-maps need --pbr")
+    if a.pbr and (a.ref_chunks < 2 or a.ref_spp % a.ref_chunks):
+        p.error("--ref-chunks must be at least 2 and divide --ref-spp")
     if not os.access(a.wavepath, os.X_OK):
         p.error("%s is not an executable (build it: cmake --build build --target wavepath)"
                 % a.wavepath)
@@ -332,15 +493,85 @@ def parse_args(argv):
 
 
 def timed(cmd, env=None):
-    """Runs cmd; its wall time in seconds. Exits with its output when it fails."""
+    """Runs cmd; (its wall time in seconds, its output, its CPU time: user + system seconds of
+    the process and the children it waited for). Exits with its output when it fails."""
+    import resource
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           env=env)
     t = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode != 0:
         sys.exit("peers.py: error: %s failed (%d):\n%s" % (" ".join(cmd), proc.returncode,
                                                           proc.stdout[-4000:]))
-    return t, proc.stdout
+    return t, proc.stdout, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def cpu_snapshot():
+    """(busy, steal, own) CPU seconds so far: the machine's busy time over all cores (user, nice,
+    system, irq, softirq in /proc/stat), the time the hypervisor took (steal), and this script's
+    own (this process and the children it waited for); None where /proc/stat is missing."""
+    import resource
+    try:
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:9]]
+    except (OSError, ValueError):
+        return None
+    tick = os.sysconf("SC_CLK_TCK")
+    own = sum(getattr(resource.getrusage(w), k) for w in (resource.RUSAGE_SELF,
+                                                          resource.RUSAGE_CHILDREN)
+              for k in ("ru_utime", "ru_stime"))
+    return (v[0] + v[1] + v[2] + v[5] + v[6]) / tick, v[7] / tick, own
+
+
+def other_work(before, after, wall):
+    """{"other", "steal", "capacity"} CPU seconds between two cpu_snapshot()s `wall` seconds
+    apart: busy time not this script's, hypervisor steal, and cores x wall."""
+    if before is None or after is None:
+        return None
+    return {"other": max(0.0, (after[0] - before[0]) - (after[2] - before[2])),
+            "steal": after[1] - before[1], "capacity": wall * (os.cpu_count() or 1)}
+
+
+def convert_pbr(a):
+    """--pbr: the scene as Cycles' worker reads it (the glTF itself, the camera, the environment).
+    A file without a camera is rendered by both from a copy (--work/with_camera.glb or .gltf)
+    holding wavepath's framing camera, so that both see it through the same one."""
+    os.makedirs(a.work, exist_ok=True)
+    a.render_scene = a.scene
+    cam = peers_scene.camera(a.scene)
+    edits, name = [], []
+    if cam is None:
+        lo, hi = peers_scene.bounds(a.scene)
+        cam = peers_scene.framing_camera(lo, hi, a.width / a.height)
+        edits.append(peers_scene.add_camera(cam))
+        name.append("with_camera")
+    if a.nearest_textures:
+        edits.append(peers_scene.nearest_textures)
+        name.append("nearest")
+    if a.no_normal_maps:
+        edits.append(peers_scene.no_normal_maps)
+        name.append("no_normal_maps")
+    if edits:
+        a.render_scene = os.path.join(a.work, "_".join(name)
+                                      + os.path.splitext(a.scene)[1].lower())
+        peers_scene.copy_gltf(a.scene, a.render_scene, edits)
+    scene = {"gltf": os.path.abspath(a.render_scene), "camera": cam,
+             "env": os.path.abspath(a.env) if a.env else None,
+             "env_intensity": a.env_intensity, "env_rotation": a.env_rotation}
+    path = os.path.join(a.work, "scene.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    return scene, path
+
+
+def wavepath_scene_args(a):
+    """wavepath's options for the environment (none without --env)."""
+    if not a.env:
+        return []
+    return ["--env", a.env, "--env-intensity", repr(a.env_intensity), "--env-rotation",
+            repr(a.env_rotation)]
 
 
 def convert(a):
@@ -370,25 +601,27 @@ def convert(a):
     return scene, path
 
 
-def run_one(a, renderer, spp, seed, scene_json, env):
-    """(wall seconds, image top row first)."""
+def run_one(a, renderer, spp, seed, scene_json, env, name=None):
+    """(wall seconds, image top row first, CPU seconds)."""
     import numpy as np
     import accuracy_lib as al
-    out = os.path.join(a.work, "%s-%d.npy" % (renderer, spp))
+    out = os.path.join(a.work, "%s-%s.npy" % (renderer, name or spp))
     if renderer == "wavepath":
         pfm = out[:-4] + ".pfm"
-        t, _ = timed([a.wavepath, "render", a.render_scene, "--width", str(a.width), "--height",
+        t, _, cpu = timed([a.wavepath, "render", a.render_scene, "--width", str(a.width), "--height",
                       str(a.height), "--spp", str(spp), "--seed", str(seed), "--max-depth",
-                      str(a.max_depth), "--rr-depth", str(a.rr_depth), "-o", pfm, "--json", "-q"])
-        return t, al.read_pfm(pfm)
+                      str(a.max_depth), "--rr-depth", str(a.rr_depth), "-o", pfm, "--json", "-q"]
+                     + wavepath_scene_args(a))
+        return t, al.read_pfm(pfm), cpu
     job = {"scene": scene_json, "spp": spp, "seed": seed, "width": a.width, "height": a.height,
            "max_depth": a.max_depth, "rr_depth": a.rr_depth, "out": out,
            "variant": a.mitsuba_variant}
     job_path = out[:-4] + ".json"
     with open(job_path, "w") as f:
         json.dump(job, f)
-    t, _ = timed([sys.executable, os.path.abspath(__file__), "--worker", renderer, job_path], env)
-    return t, np.load(out)
+    t, _, cpu = timed([sys.executable, os.path.abspath(__file__), "--worker", renderer, job_path],
+                      env)
+    return t, np.load(out), cpu
 
 
 def reference(a):
@@ -400,16 +633,82 @@ def reference(a):
         h.update(f.read())
     h.update(json.dumps([a.width, a.height, a.ref_spp, a.max_depth, a.rr_depth,
                          os.stat(a.wavepath).st_mtime_ns]).encode())
+    if a.env:
+        with open(a.env, "rb") as f:
+            h.update(f.read())
+        h.update(json.dumps(wavepath_scene_args(a)[2:]).encode())
     key = h.hexdigest()[:16]
     path = os.path.join(a.work, "reference-%d-%s.npz" % (a.ref_spp, key))
     if not os.path.exists(path):
         log("reference: wavepath, %d spp, %dx%d" % (a.ref_spp, a.width, a.height))
         img, var, info = al.render(a.wavepath, a.render_scene, ["--max-depth", str(a.max_depth),
-                                                         "--rr-depth", str(a.rr_depth)],
+                                                         "--rr-depth", str(a.rr_depth)]
+                                   + wavepath_scene_args(a),
                                    a.width, a.height, a.ref_spp, al.REFERENCE_SEED)
         np.savez(path, img=img, var=var, seconds=info["total_seconds"])
     data = np.load(path)
     return data["img"], data["var"], float(data["seconds"])
+
+
+def cycles_reference(a, scene_json, env):
+    """--pbr: (image, variance image, seconds) of Cycles' own reference: the mean of --ref-chunks
+    runs of --ref-spp / --ref-chunks samples, seeds 7000, 7001, ...; the variance image is the
+    per-pixel sample variance of the runs over their number. Cached in --work by its settings."""
+    import numpy as np
+    h = hashlib.sha256()
+    for f in [a.render_scene] + ([a.env] if a.env else []):
+        with open(f, "rb") as fh:
+            h.update(fh.read())
+    h.update(json.dumps([a.width, a.height, a.ref_spp, a.ref_chunks, a.max_depth, a.rr_depth,
+                         a.env_intensity, a.env_rotation, versions(["cycles"], env)["cycles"]])
+             .encode())
+    import inspect  # the Cycles worker's code, so that a change to it renders afresh
+    for f in (_cycles_settings, _cycles_camera, _cycles_render, worker_cycles,
+              _cycles_backface_transparent, worker_cycles_gltf):
+        h.update(inspect.getsource(f).encode())
+    path = os.path.join(a.work, "reference-cycles-%d-%s.npz" % (a.ref_spp, h.hexdigest()[:16]))
+    if not os.path.exists(path):
+        spp = a.ref_spp // a.ref_chunks
+        runs, seconds = [], 0.0
+        for k in range(a.ref_chunks):
+            log("reference: cycles, run %d of %d, %d spp, %dx%d" % (k + 1, a.ref_chunks, spp,
+                                                                    a.width, a.height))
+            t, img, _ = run_one(a, "cycles", spp, 7000 + k, scene_json, env, name="ref%d" % k)
+            runs.append(img)
+            seconds += t
+        runs = np.array(runs)
+        np.savez(path, img=runs.mean(0), var=runs.var(0, ddof=1) / len(runs), seconds=seconds)
+    data = np.load(path)
+    return data["img"], data["var"], float(data["seconds"])
+
+
+def background_mask(a):
+    """--pbr: (background, object) boolean masks from wavepath's depth AOV (64 spp). A pixel's
+    depth is the mean over its samples, 0 for a miss, so it is 0 exactly when every sample saw
+    the background. Background: such pixels whose 4-neighbours are too; object: pixels at least
+    two pixels (4-connected) away from any such pixel. The band along silhouettes, where a pixel
+    sees both, belongs to neither."""
+    import numpy as np
+    out = os.path.join(a.work, "mask.pfm")
+    timed([a.wavepath, "render", a.render_scene, "--width", str(a.width), "--height",
+           str(a.height), "--spp", "64", "--seed", "1", "--max-depth", "1", "-o", out,
+           "--aov", "depth", "-q"] + wavepath_scene_args(a))
+    with open(out[:-4] + ".depth.pfm", "rb") as f:
+        data = f.read()
+    head = data.split(b"\n", 3)
+    w, hgt = (int(t) for t in head[1].split())
+    depth = np.frombuffer(head[3], dtype="<f4" if float(head[2]) < 0 else ">f4",
+                          count=w * hgt).reshape(hgt, w)[::-1]
+
+    def erode(m):
+        e = m.copy()
+        e[1:, :] &= m[:-1, :]
+        e[:-1, :] &= m[1:, :]
+        e[:, 1:] &= m[:, :-1]
+        e[:, :-1] &= m[:, 1:]
+        return e
+    bg = depth == 0.0
+    return erode(bg), erode(erode(~bg))
 
 
 def time_to_target(points, target):
@@ -457,7 +756,8 @@ def chart(a, rows, path):
     for target in a.targets:
         ax.axhline(target, color="0.7", lw=0.8, ls="--")
     ax.set_xlabel("wall time of the whole process (s)")
-    ax.set_ylabel("relMSE against the reference")
+    ax.set_ylabel("relMSE against the renderer's own reference" if a.pbr
+                  else "relMSE against the reference")
     ax.set_title("%s, %d x %d (labels: samples per pixel)"
                  % (os.path.basename(a.scene), a.width, a.height))
     ax.grid(True, which="both", lw=0.3)
@@ -476,15 +776,88 @@ def fmt_t(t, mark=""):
 NOTES_MARK = "<!-- notes: kept when the page is regenerated -->"
 
 
-def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
-    by = {r: sorted((x for x in rows if x["renderer"] == r), key=lambda x: x["spp"])
-          for r in a.renderers}
+def _cpu_name():
     cpu = platform.processor() or platform.machine()
     try:
         with open("/proc/cpuinfo") as f:
             cpu = re.search(r"model name\s*:\s*(.*)", f.read()).group(1)
     except (OSError, AttributeError):
         pass
+    return cpu
+
+
+def _by_renderer(a, rows):
+    return {r: sorted((x for x in rows if x["renderer"] == r), key=lambda x: x["spp"])
+            for r in a.renderers}
+
+
+def _time_table(a, by, key="seconds"):
+    """The time-to-target table's lines (from each run's `key`: wall or CPU seconds)."""
+    head = "| relMSE target |" + "".join(" %s |" % LABELS[r] for r in a.renderers)
+    peers = [r for r in a.renderers if r != "wavepath"]
+    if "wavepath" in a.renderers:
+        head += "".join(" %s / wavepath |" % LABELS[r].split(" (")[0] for r in peers)
+    L = [head, "|" + "---|" * (head.count("|") - 1)]
+    for target in a.targets:
+        tt = {r: time_to_target([(x[key], x["rel_mse"]) for x in by[r]], target)
+              for r in a.renderers}
+        line = "| %g |" % target + "".join(" %s |" % fmt_t(*tt[r]) for r in a.renderers)
+        if "wavepath" in a.renderers:
+            w = tt["wavepath"][0]
+            for r in peers:
+                p = tt[r][0]
+                line += " %s |" % ("%.2f" % (p / w) if p and w else "—")
+        L.append(line)
+    return L
+
+
+def _runs_table(a, by, ref_word="reference"):
+    if a.repeat > 1:
+        L = ["| renderer | spp | time (s) | times of the %d repetitions (s) | CPU time (s) | "
+             "relMSE | image mean / %s |" % (a.repeat, ref_word), "|---|---|---|---|---|---|---|"]
+        for r in a.renderers:
+            for x in by[r]:
+                L.append("| %s | %d | %.2f | %s | %.2f | %.3g | %.4f |"
+                         % (LABELS[r], x["spp"], x["seconds"],
+                            ", ".join("%.2f" % t for t in x["all_seconds"]), x["cpu_seconds"],
+                            x["rel_mse"], x["mean_ratio"]))
+        return L
+    L = ["| renderer | spp | time (s) | relMSE | image mean / %s |" % ref_word,
+         "|---|---|---|---|---|"]
+    for r in a.renderers:
+        for x in by[r]:
+            L.append("| %s | %d | %.2f | %.3g | %.4f |" % (LABELS[r], x["spp"], x["seconds"],
+                                                         x["rel_mse"], x["mean_ratio"]))
+    return L
+
+
+def _repeat_sentence(a):
+    if a.repeat == 1:
+        return ""
+    return (" Each run's time is the least of %d: the sweep was run %d times, the renderers "
+            "taking turns at each sample count, with the same seeds (so the same images); all "
+            "times are listed under *Every run*, with the least CPU time (user + system seconds "
+            "of the process and its children), which other work on the machine changes much "
+            "less than the wall time. The least wall time is the run least disturbed by other "
+            "work." % (a.repeat, a.repeat))
+
+
+def _write_with_notes(a, L):
+    """Writes the page's lines L and then the kept notes (see NOTES_MARK)."""
+    notes = NOTES_MARK + "\n"
+    if os.path.exists(a.out):
+        with open(a.out) as f:
+            old = f.read()
+        if NOTES_MARK in old:
+            notes = old[old.index(NOTES_MARK):]
+    L += ["", notes]
+    with open(a.out, "w") as f:
+        f.write("\n".join(L))
+
+
+def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
+    by = _by_renderer(a, rows)
+    cpu = _cpu_name()
     cmd = "tools/peers.py " + " ".join(a.argv)
     L = ["# Peer benchmark: wavepath, Mitsuba 3, Cycles", "",
          "Written by `tools/peers.py` (see its `--help`); regenerate with", "",
@@ -503,7 +876,8 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
          "compilation, scene load, rendering, writing the image), measured by the script; "
          "relMSE = mean(((x − r)² − var_r) / (r² + 0.01)) against the common reference "
          "(tools/accuracy_lib.py). One unmeasured 1-spp run of each renderer first fills the "
-         "caches kept between processes (wavepath's kernel binary and BVH, Dr.Jit's kernels).", "",
+         "caches kept between processes (wavepath's kernel binary and BVH, Dr.Jit's kernels)."
+         + _repeat_sentence(a), "",
          "The scene is converted exactly (`tools/peers_scene.py`, tested by "
          "`tests/test_peers_scene.py`; the mapping is in `tools/peers.py --help`): triangle "
          "meshes, Lambertian reflectance, the emissive quad as a one-sided area light with the "
@@ -519,27 +893,8 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
          "Interpolated on log-log between the runs around the target; `~`: extrapolated past "
          "the largest run as relMSE ∝ 1/time; `≤`: reached by the smallest run. The ratio is the "
          "peer's time over wavepath's (above 1: wavepath is faster).", ""]
-    head = "| relMSE target |" + "".join(" %s |" % LABELS[r] for r in a.renderers)
-    peers = [r for r in a.renderers if r != "wavepath"]
-    if "wavepath" in a.renderers:
-        head += "".join(" %s / wavepath |" % LABELS[r].split(" (")[0] for r in peers)
-    L += [head, "|" + "---|" * (head.count("|") - 1)]
-    for target in a.targets:
-        tt = {r: time_to_target([(x["seconds"], x["rel_mse"]) for x in by[r]], target)
-              for r in a.renderers}
-        line = "| %g |" % target + "".join(" %s |" % fmt_t(*tt[r]) for r in a.renderers)
-        if "wavepath" in a.renderers:
-            w = tt["wavepath"][0]
-            for r in peers:
-                p = tt[r][0]
-                line += " %s |" % ("%.2f" % (p / w) if p and w else "—")
-        L.append(line)
-    L += ["", "## Every run", "", "| renderer | spp | time (s) | relMSE | image mean / reference |",
-          "|---|---|---|---|---|"]
-    for r in a.renderers:
-        for x in by[r]:
-            L.append("| %s | %d | %.2f | %.3g | %.4f |" % (LABELS[r], x["spp"], x["seconds"],
-                                                         x["rel_mse"], x["mean_ratio"]))
+    L += _time_table(a, by)
+    L += ["", "## Every run", ""] + _runs_table(a, by)
     L += ["", "## Conversion check: image means", "",
           "Each renderer's largest run against the reference, per channel (mean over all pixels, "
           "ratio to the reference's). The standard error of the ratio is estimated from the "
@@ -550,15 +905,185 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
         c = checks[r]
         L.append("| %s | %d | %.4f | %.4f | %.4f | %.4f |" % (LABELS[r], c["spp"], *c["ratio"],
                                                              c["se"]))
-    notes = NOTES_MARK + "\n"
-    if os.path.exists(a.out):
-        with open(a.out) as f:
-            old = f.read()
-        if NOTES_MARK in old:
-            notes = old[old.index(NOTES_MARK):]
-    L += ["", notes]
-    with open(a.out, "w") as f:
-        f.write("\n".join(L))
+    _write_with_notes(a, L)
+
+
+def compare_references(refs, masks):
+    """--pbr: the two references against each other, per region ("all", "background",
+    "object"): pixel count, Cycles' mean over wavepath's per channel with 1 s.e. (from both
+    variance images), and relMSE = mean(((c - w)^2 - var_c - var_w) / (w^2 + 0.01)), the
+    difference beyond both references' noise."""
+    import numpy as np
+    (w, wv), (c, cv) = refs["wavepath"], refs["cycles"]
+    regions = {"all": np.ones(w.shape[:2], bool), "background": masks[0], "object": masks[1]}
+    out = {}
+    for name, m in regions.items():
+        n = int(m.sum())
+        if n == 0:
+            continue
+        mw, mc = w[m].mean(0), c[m].mean(0)
+        vw, vc = wv[m].sum(0) / n ** 2, cv[m].sum(0) / n ** 2
+        ratio = mc / mw
+        se = ratio * np.sqrt(vc / mc ** 2 + vw / mw ** 2)
+        rel = float((((c - w) ** 2 - cv - wv) / (w * w + 0.01))[m].mean())
+        out[name] = {"pixels": n, "ratio": [float(x) for x in ratio],
+                     "se": [float(x) for x in se], "rel_mse": rel}
+    return out
+
+
+def references_image(a, refs, path):
+    """--pbr: wavepath's and Cycles' references side by side (linear values clamped to [0, 1],
+    sRGB-encoded) and the ratio of their luminances as a map of stops."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    def srgb(x):
+        x = np.clip(x, 0.0, 1.0)
+        return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+
+    lum = np.array([0.2126, 0.7152, 0.0722])
+    w, c = refs["wavepath"][0], refs["cycles"][0]
+    stops = np.log2((c @ lum + 1e-3) / (w @ lum + 1e-3))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4.3), dpi=100)
+    for ax, img, title in ((axes[0], w, "wavepath reference"), (axes[1], c, "Cycles reference")):
+        ax.imshow(srgb(img), interpolation="nearest")
+        ax.set_title(title)
+    im = axes[2].imshow(stops, cmap="coolwarm", vmin=-0.5, vmax=0.5, interpolation="nearest")
+    axes[2].set_title("log2(Cycles / wavepath), luminance")
+    fig.colorbar(im, ax=axes[2], fraction=0.046, pad=0.04, label="stops")
+    for ax in axes:
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.suptitle("%s under %s, %d x %d (clamped to [0, 1], sRGB)"
+                 % (os.path.basename(a.scene), os.path.basename(a.env) if a.env else "black",
+                    a.width, a.height))
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
+    """The page of a --pbr run."""
+    by = _by_renderer(a, rows)
+    cmd = "tools/peers.py " + " ".join(a.argv)
+    cam_copy = "with_camera" in os.path.basename(a.render_scene)
+    env = ("under the environment map `%s` (intensity %g, rotation %g°)"
+           % (os.path.relpath(a.env, REPO), a.env_intensity, a.env_rotation) if a.env
+           else "with a black background")
+    refs = "; ".join(
+        {"wavepath": "wavepath: %d spp, one run (%.0f s)",
+         "cycles": "Cycles: %%d spp as the mean of %d runs of %d spp with different seeds "
+                   "(%%.0f s)" % (a.ref_chunks, a.ref_spp // a.ref_chunks)}[r]
+        % (a.ref_spp, ref_info[r]) for r in a.renderers)
+    L = ["# Peer benchmark: wavepath and Cycles on a textured model", "",
+         "Written by `tools/peers.py --pbr` (see its `--help`); regenerate with", "",
+         "    " + cmd, "",
+         "Scene `%s` %s, %d × %d, max depth %d scattering events, Russian roulette after %d "
+         "(wavepath's); sweep %s samples per pixel; references: %s. Machine: %s, %d cores%s; "
+         "both render on the CPU. Versions: %s."
+         % (os.path.relpath(a.scene, REPO), env, a.width, a.height, a.max_depth, a.rr_depth,
+            ", ".join(map(str, a.spp)), refs, _cpu_name(), os.cpu_count(),
+            "" if other is None else
+            "; other work used %.0f%% of the machine's CPU time during the sweep (%.0f of %.0f "
+            "core-seconds: its busy time in /proc/stat less this script's own processes; "
+            "whichever renderer runs then is slowed), the hypervisor took %.1f%% (steal)"
+            % (100 * other["other"] / other["capacity"], other["other"], other["capacity"],
+               100 * other["steal"] / other["capacity"]),
+            "; ".join("%s: %s" % kv for kv in vers.items())), "",
+         "Time is the wall time of each render's whole process, measured by the script from "
+         "its start to the image on disk. wavepath: start-up, loading the glTF and decoding its "
+         "textures, loading the environment map and building its sampling tables, the kernel "
+         "binary and BVH (both from wavepath's caches, filled by an unmeasured 1-spp run "
+         "first), rendering, writing a PFM. Cycles: starting Python and importing `bpy`, "
+         "Blender's glTF importer, the scene set-up below, rendering (with Cycles' own BVH "
+         "build and texture loading), writing an EXR and reading it back into a NumPy file; "
+         "also after an unmeasured 1-spp run." + _repeat_sentence(a), "",
+         "**Each renderer's error is measured against its own reference** (relMSE = "
+         "mean(((x − r)² − var_r) / (r² + 0.01)), tools/accuracy_lib.py, with r and var_r that "
+         "renderer's reference and its variance image; wavepath's reference is rendered with "
+         "independent samples, as tools/accuracy_lib.py renders references, because only then "
+         "is its variance image the error's, while the sweep runs use wavepath's default "
+         "sampler; Cycles' variance image is the spread of independently seeded runs, right "
+         "for any sampler, and all its runs use its default sampler): the two do not render exactly the same "
+         "material model (below), so one common reference would charge the model difference to "
+         "one of them as error that no number of samples removes. The comparison is noise "
+         "against time: how long each needs to get within a relMSE of its own converged image. "
+         "How far the two converged images are apart is measured separately below.", "",
+         "How the scene is given to each (`tools/peers.py --help`, PBR MODE): wavepath renders "
+         "the glTF; Cycles imports the same file with Blender's glTF importer (textures, "
+         "metallic-roughness as a Principled BSDF, the normal map as a tangent-space Normal "
+         "Map node), with every Principled BSDF switched to single-scatter GGX (Blender's "
+         "default is multiscatter GGX), subsurface off, and back faces of materials that are not "
+         "double-sided made transparent (wavepath culls them). %s"
+         "The environment is the world's Environment Texture with the same intensity, "
+         "nearest-texel lookup (`Closest`, as wavepath) and the same orientation (a Mapping node "
+         "turns Blender's equirectangular convention into wavepath's; checked by the background "
+         "pixels below). One-pixel box filter, max bounces = max depth − 1 (Cycles counts "
+         "bounces after the first hit), no clamping, no filter glossy, no adaptive sampling, no "
+         "denoising; Cycles' light tree off (on this scene it was both slower and noisier: "
+         "256 spp in 6.8 s at relMSE 3.0·10⁻³ with it, 5.6 s at 2.6·10⁻³ without, mean of 3 "
+         "seeds; the Cornell box page leaves it at Blender's default, on)."
+         % ("The file has no camera: both render a copy with wavepath's framing camera "
+            "(45° vertical field of view, the bounding sphere fitted) written into it "
+            "(`peers_scene.with_camera`). " if cam_copy else "")
+         + (" **Both sample every texture at its nearest texel** (--nearest-textures: a copy "
+            "of the file with NEAREST samplers, which Blender's importer turns into Closest "
+            "interpolation), unlike the file's own (linear) filtering." if a.nearest_textures
+            else "")
+         + (" **Both render the model without its normal map** (--no-normal-maps: a copy of "
+            "the file without normal textures)." if a.no_normal_maps else ""), "",
+         "What the two material models do not share: Blender's Principled BSDF reflects "
+         "dielectrics with the exact Fresnel equations (IOR 1.5, the importer's \"Specular IOR "
+         "Level\" 0.5) and scales the diffuse base by the specular layer's albedo, where glTF "
+         "(and wavepath) mix diffuse and specular with Schlick's Fresnel at the half-vector "
+         "(`kernels/bsdf.h`); its metals use the F82-tint model (with a white tint: Schlick "
+         "with the base colour as F0, as glTF, only up to a small grazing-angle term); the "
+         "tangent frames of the normal map come from different tangent generators (Blender's "
+         "MikkTSpace, wavepath's own, the file has no tangents); the occlusion texture is used "
+         "by neither.", "",
+         "![relMSE against time](%s)" % names["chart"], "",
+         "## Time to reach a relMSE target", "",
+         "Interpolated on log-log between the runs around the target; `~`: extrapolated past "
+         "the largest run as relMSE ∝ 1/time; `≤`: reached by the smallest run. The ratio is "
+         "Cycles' time over wavepath's (above 1: wavepath is faster).", ""]
+    L += _time_table(a, by)
+    if a.repeat > 1:
+        L += ["", "The same by CPU time (user + system seconds, the least of the repetitions): "
+              "the work each process did on the 2 cores, whatever else was running; with both "
+              "cores busy all along it would be about twice the wall time.", ""]
+        L += _time_table(a, by, "cpu_seconds")
+    L += ["", "## Every run", "", "relMSE and image mean against the renderer's own reference.",
+          ""] + _runs_table(a, by, "own reference")
+    L += ["", "## Each renderer against its own reference: image means", "",
+          "Each renderer's largest run against its own reference, per channel. The standard "
+          "error of the ratio is estimated from the reference's variance image scaled to the "
+          "run's sample count (for wavepath's runs, whose default sampler has less error than "
+          "independent samples, an overestimate).", "",
+          "| renderer | spp | R | G | B | ± (1 s.e.) |", "|---|---|---|---|---|---|"]
+    for r in a.renderers:
+        c = checks[r]
+        L.append("| %s | %d | %.4f | %.4f | %.4f | %.4f |" % (LABELS[r], c["spp"], *c["ratio"],
+                                                             c["se"]))
+    if ref_cmp:
+        L += ["", "## Conversion check: the two references", "",
+              "Cycles' reference against wavepath's: per channel the ratio of the image means "
+              "(± 1 s.e. from both variance images), and relMSE between the two, (Cycles − "
+              "wavepath)² less both variance images over (wavepath² + 0.01), the difference "
+              "beyond the references' noise. Regions from wavepath's depth AOV: *background* are "
+              "pixels where every sample missed the model (their 4-neighbours too): they see the "
+              "environment map only and test its conversion (orientation, intensity, "
+              "lookup); *object* are pixels at least two pixels inside the model's silhouette: "
+              "they test the materials. The silhouette band between them counts in *all* only.",
+              "",
+              "| region | pixels | R | G | B | ± (1 s.e., largest) | relMSE between references |",
+              "|---|---|---|---|---|---|---|"]
+        for name, c in ref_cmp.items():
+            L.append("| %s | %d | %.4f | %.4f | %.4f | %.2g | %.3g |"
+                     % (name, c["pixels"], *c["ratio"], max(c["se"]), c["rel_mse"]))
+        L += ["", "![the two references and their ratio](%s)" % names["references"]]
+    _write_with_notes(a, L)
 
 
 def main(argv):
@@ -579,43 +1104,106 @@ def main(argv):
                      % a.mitsuba_variant)
         env["DRJIT_LIBLLVM_PATH"] = llvm
         log("libLLVM: " + llvm)
-    scene, scene_json = convert(a)
-    s = peers_scene.summary(scene)
-    log("scene: %d triangles, %d emitters, %d point lights"
-        % (s["triangles"], len(s["emitters"]), len(scene["point_lights"])))
+    if a.pbr:
+        scene, scene_json = convert_pbr(a)
+        log("scene: %s (%s camera), environment %s"
+            % (a.render_scene, "its own" if a.render_scene == a.scene else "wavepath's framing",
+               a.env or "black"))
+    else:
+        scene, scene_json = convert(a)
+        s = peers_scene.summary(scene)
+        log("scene: %d triangles, %d emitters, %d point lights"
+            % (s["triangles"], len(s["emitters"]), len(scene["point_lights"])))
     ref, ref_var, ref_seconds = reference(a)
-    n = ref.shape[0] * ref.shape[1]
-    ref_mean = ref.reshape(-1, 3).mean(0)
+    # Without --pbr every renderer is measured against wavepath's reference; with it, each
+    # against its own.
+    refs = {r: (ref, ref_var) for r in a.renderers}
+    ref_info = {"wavepath": ref_seconds}
+    if a.pbr and "cycles" in a.renderers:
+        cimg, cvar, ref_info["cycles"] = cycles_reference(a, scene_json, env)
+        refs["cycles"] = (cimg, cvar)
     rows, checks = [], {}
+
+    def score(row, img):
+        """Fills row's relMSE and mean ratio from its image (and checks[] for the largest)."""
+        r, spp = row["renderer"], row["spp"]
+        rimg, rvar = refs[r]
+        if img.shape != rimg.shape:
+            sys.exit("peers.py: error: %s gave an image of shape %s, not %s"
+                     % (r, img.shape, rimg.shape))
+        st = al.compare(img, np.zeros_like(img), rimg, rvar)
+        row.update(rel_mse=st["rel_mse"], mean_ratio=float(img.mean() / rimg.mean()))
+        log("%-8s %5d spp  %7.2f s%s  relMSE %.4g  mean ratio %.4f"
+            % (r, spp, row["seconds"], " (least of %s)" % " ".join(
+                "%.2f" % x for x in row["all_seconds"]) if a.repeat > 1 else "",
+               row["rel_mse"], row["mean_ratio"]))
+        if spp == max(a.spp):
+            # Var of a channel's image mean, run and reference: sum of pixel variances / n^2.
+            n = rimg.shape[0] * rimg.shape[1]
+            rmean = rimg.reshape(-1, 3).mean(0)
+            v = rvar.reshape(-1, 3).sum(0) / n ** 2
+            se = np.sqrt(v * a.ref_spp / spp + v) / rmean
+            checks[r] = {"spp": spp, "ratio": [float(x) for x in img.reshape(-1, 3).mean(0)
+                                               / rmean], "se": float(se.max())}
+
     load_before = os.getloadavg()[0]
-    for r in a.renderers:
-        run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
-        for k, spp in enumerate(a.spp):
-            seed = 1000 + k
-            t, img = run_one(a, r, spp, seed, scene_json, env)
-            if img.shape != ref.shape:
-                sys.exit("peers.py: error: %s gave an image of shape %s, not %s"
-                         % (r, img.shape, ref.shape))
-            st = al.compare(img, np.zeros_like(img), ref, ref_var)
-            ratio = img.reshape(-1, 3).mean(0) / ref_mean
-            rows.append({"renderer": r, "spp": spp, "seconds": t, "rel_mse": st["rel_mse"],
-                         "mean_ratio": float(img.mean() / ref.mean())})
-            log("%-8s %5d spp  %7.2f s  relMSE %.4g  mean ratio %.4f"
-                % (r, spp, t, st["rel_mse"], rows[-1]["mean_ratio"]))
-            if spp == max(a.spp):
-                # Var of a channel's image mean, run and reference: sum of pixel variances / n^2.
-                v = ref_var.reshape(-1, 3).sum(0) / n ** 2
-                se = np.sqrt(v * a.ref_spp / spp + v) / ref_mean
-                checks[r] = {"spp": spp, "ratio": [float(x) for x in ratio],
-                             "se": float(se.max())}
+    cpu_before, wall_before = cpu_snapshot(), time.perf_counter()
+    if a.repeat == 1:
+        for r in a.renderers:
+            run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
+            for k, spp in enumerate(a.spp):
+                t, img, cpu = run_one(a, r, spp, 1000 + k, scene_json, env)
+                rows.append({"renderer": r, "spp": spp, "seconds": t, "cpu_seconds": cpu})
+                score(rows[-1], img)
+    else:
+        # --repeat: every renderer's warm-up, then the sweep N times, the renderers taking turns
+        # at each sample count (so that both meet much the same other work), with the same
+        # seeds (the same images: both renderers are deterministic); a run's time is the least
+        # of its repetitions.
+        for r in a.renderers:
+            run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
+        rows = [{"renderer": r, "spp": spp, "all_seconds": [], "all_cpu_seconds": []}
+                for r in a.renderers for spp in a.spp]
+        row_of = {(x["renderer"], x["spp"]): x for x in rows}
+        images = {}
+        for rep in range(a.repeat):
+            for k, spp in enumerate(a.spp):
+                for r in a.renderers:
+                    t, img, cpu = run_one(a, r, spp, 1000 + k, scene_json, env)
+                    row_of[(r, spp)]["all_seconds"].append(t)
+                    row_of[(r, spp)]["all_cpu_seconds"].append(cpu)
+                    images.setdefault((r, spp), img)
+                    log("%-8s %5d spp  %7.2f s  CPU %7.2f s  (repetition %d of %d)"
+                        % (r, spp, t, cpu, rep + 1, a.repeat))
+        for row in rows:
+            row["seconds"] = min(row["all_seconds"])
+            row["cpu_seconds"] = min(row["all_cpu_seconds"])
+            score(row, images[(row["renderer"], row["spp"])])
+    load_after = os.getloadavg()[0]
+    other = other_work(cpu_before, cpu_snapshot(), time.perf_counter() - wall_before)
     with open(os.path.join(a.work, "runs.json"), "w") as f:
         json.dump(rows, f, indent=1)
     base = os.path.splitext(a.out)[0]
+    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     chart_path = base + "_" + os.path.splitext(os.path.basename(a.scene))[0] + ".png"
     chart(a, rows, chart_path)
-    write_doc(a, rows, checks, ref_seconds, versions(a.renderers, env),
-              os.path.relpath(chart_path, os.path.dirname(os.path.abspath(a.out))),
-              (load_before, os.getloadavg()[0]))
+    page_dir = os.path.dirname(os.path.abspath(a.out))
+    if a.pbr:
+        names = {"chart": os.path.relpath(chart_path, page_dir)}
+        ref_cmp = None
+        if "cycles" in a.renderers and "wavepath" in a.renderers:
+            ref_cmp = compare_references(refs, background_mask(a))
+            refs_path = base + "_references.png"
+            references_image(a, refs, refs_path)
+            names["references"] = os.path.relpath(refs_path, page_dir)
+            for name, c in ref_cmp.items():
+                log("references, %-10s Cycles / wavepath %s  relMSE %.3g"
+                    % (name, " ".join("%.4f" % x for x in c["ratio"]), c["rel_mse"]))
+        write_doc_pbr(a, rows, checks, ref_info, ref_cmp, versions(a.renderers, env), names,
+                      other)
+    else:
+        write_doc(a, rows, checks, ref_seconds, versions(a.renderers, env),
+                  os.path.relpath(chart_path, page_dir), (load_before, load_after))
     log("wrote %s and %s" % (a.out, chart_path))
 
 

@@ -13,6 +13,12 @@ Standard library only, so that tests/test_peers_scene.py runs without PyPI.
                            #  "aspect" (width / height, None when the glTF leaves it open)}
     peers_scene.write_ply(path, mesh)   # binary little-endian PLY of one mesh
     peers_scene.lambertian_copy(path, out)  # the .gltf with specularFactor 0 on every material
+    peers_scene.bounds(path)            # (lo, hi): world-space bounds of the triangle vertices
+    peers_scene.framing_camera(lo, hi, aspect)  # wavepath's camera for a file without one
+    peers_scene.camera(path)            # the first camera, as scene["camera"]; None without one
+    peers_scene.with_camera(path, out, cam)  # a copy (.gltf or .glb) with cam as its camera
+    peers_scene.copy_gltf(path, out, [peers_scene.add_camera(cam), peers_scene.nearest_textures])
+                                        # (edits: add_camera, nearest_textures, no_normal_maps)
 
 Only what the peers can represent exactly is accepted: triangle primitives, Lambertian materials
 (metallic 0, roughness 1, base colour factor and emission without textures, opaque), point lights,
@@ -26,10 +32,16 @@ wavepath's (scenes/README.md): metres, +Y up, linear RGB, emission = emissiveFac
 emissiveStrength as radiance, point light intensity x colour read as W/sr; a triangle's front is the
 side from which its vertices run counter-clockwise, and a material that is not double-sided is
 invisible from the back (wavepath culls back faces: rays pass through them).
+
+bounds(), framing_camera(), camera(), with_camera() and copy_gltf() work on any glTF (textures
+and all): they serve the --pbr mode of tools/peers.py, where Cycles imports the file itself and
+both renderers must see it through the same camera (and, for the diagnostics --nearest-textures
+and --no-normal-maps, a copy with its textures sampled alike or without its normal maps).
 """
 
 import base64
 import json
+import mimetypes
 import math
 import os
 import struct
@@ -271,6 +283,197 @@ def load(path):
         "aspect": cam["perspective"].get("aspectRatio"),
     }
     return scene
+
+
+# ---- Geometry and cameras of any glTF (the --pbr mode) -------------------------------------------
+
+def _walk(doc, visit_node):
+    """Calls visit_node(node, world matrix) for every node of the default scene, depth first,
+    children after their parent, roots in the scene's order."""
+    identity = [[float(i == j) for j in range(4)] for i in range(4)]
+
+    def visit(index, parent):
+        node = doc["nodes"][index]
+        world = _matmul(parent, node_matrix(node))
+        visit_node(node, world)
+        for child in node.get("children", []):
+            visit(child, world)
+
+    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        visit(root, identity)
+
+
+def bounds(path):
+    """(lo, hi): the world-space bounds of the vertices that triangle primitives use, as
+    wavepath's loader computes them (its framing camera is made from them)."""
+    doc, buffers = _read_document(path)
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+
+    def visit_node(node, world):
+        if "mesh" not in node:
+            return
+        for prim in doc["meshes"][node["mesh"]]["primitives"]:
+            if prim.get("mode", 4) != 4:
+                continue  # wavepath skips non-triangle primitives
+            positions = _accessor(doc, buffers, prim["attributes"]["POSITION"])
+            used = (sorted(set(_accessor(doc, buffers, prim["indices"])))
+                    if "indices" in prim else range(len(positions)))
+            for k in used:
+                p = _point(world, positions[k])
+                for i in range(3):
+                    lo[i] = min(lo[i], p[i])
+                    hi[i] = max(hi[i], p[i])
+
+    _walk(doc, visit_node)
+    if lo[0] == math.inf:
+        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    return tuple(lo), tuple(hi)
+
+
+def framing_camera(lo, hi, aspect):
+    """wavepath's camera for a file without one (host/gltf_loader.cpp, framing_camera): 45 degree
+    vertical field of view, looking at the centre of the bounds along -Z from the +Z side, 15
+    degrees from above, at the distance where the bounding sphere fits the view at `aspect`
+    (width / height). As scene["camera"] of load(), with "aspect": aspect."""
+    center = [0.5 * (lo[i] + hi[i]) for i in range(3)]
+    radius = 0.5 * math.sqrt(sum((hi[i] - lo[i]) ** 2 for i in range(3)))
+    if not radius > 0.0 or not math.isfinite(radius):
+        radius = 1.0
+    yfov = math.radians(45.0)
+    half = min(0.5 * yfov, math.atan(math.tan(0.5 * yfov) * aspect))
+    distance = radius / math.sin(half)
+    e = math.radians(15.0)
+    back = (0.0, math.sin(e), math.cos(e))
+    return {"position": tuple(center[i] + distance * back[i] for i in range(3)),
+            "forward": tuple(-c for c in back), "up": (0.0, math.cos(e), -math.sin(e)),
+            "yfov": yfov, "aspect": aspect}
+
+
+def camera(path):
+    """The camera wavepath renders a file with by default (its first), as scene["camera"] of
+    load(); None when the file has none. ConversionError for a camera that is not perspective."""
+    doc, _ = _read_document(path)
+    cameras = []
+    _walk(doc, lambda node, world: cameras.append((doc["cameras"][node["camera"]], world))
+          if "camera" in node else None)
+    if not cameras:
+        return None
+    cam, world = cameras[0]
+    if cam.get("type") != "perspective":
+        raise ConversionError("camera type %r: only perspective converts" % cam.get("type"))
+    return {"position": _point(world, (0, 0, 0)),
+            "forward": _normalize(_vector(world, (0, 0, -1))),
+            "up": _normalize(_vector(world, (0, 1, 0))),
+            "yfov": float(cam["perspective"]["yfov"]),
+            "aspect": cam["perspective"].get("aspectRatio")}
+
+
+def _rotation_quaternion(right, up, back):
+    """(x, y, z, w) of the rotation whose matrix has columns right, up, back (orthonormal)."""
+    m = [[right[i], up[i], back[i]] for i in range(3)]
+    t = m[0][0] + m[1][1] + m[2][2]
+    if t > 0.0:
+        s = 2.0 * math.sqrt(1.0 + t)
+        return ((m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, s / 4)
+    i = max(range(3), key=lambda k: m[k][k])
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2.0 * math.sqrt(1.0 + m[i][i] - m[j][j] - m[k][k])
+    q = [0.0] * 4
+    q[i] = s / 4
+    q[j] = (m[j][i] + m[i][j]) / s
+    q[k] = (m[k][i] + m[i][k]) / s
+    q[3] = (m[k][j] - m[j][k]) / s
+    return tuple(q)
+
+
+def copy_gltf(path, out, edits):
+    """Writes a copy of `path` (.gltf or .glb; `out` the same kind) with each function of `edits`
+    applied to its JSON document in turn. Buffers and images the file keeps outside are embedded
+    as data URIs, so `out` can be anywhere; a .glb keeps its binary chunk."""
+    doc, buffers = _read_document(path)
+    base = os.path.dirname(os.path.abspath(path))
+    glb = path.lower().endswith(".glb")
+    if glb != out.lower().endswith(".glb"):
+        raise ValueError("copy_gltf: %s and %s must both be .glb or both .gltf" % (path, out))
+    for i, b in enumerate(doc.get("buffers", [])):
+        if b.get("uri") is not None and not b["uri"].startswith("data:"):
+            b["uri"] = ("data:application/octet-stream;base64,"
+                        + base64.b64encode(buffers[i]).decode("ascii"))
+    for im in doc.get("images", []):
+        uri = im.get("uri")
+        if uri is not None and not uri.startswith("data:"):
+            from urllib.parse import unquote
+            with open(os.path.join(base, unquote(uri)), "rb") as f:
+                data = f.read()
+            mime = im.get("mimeType") or mimetypes.guess_type(uri)[0] or "image/png"
+            im["uri"] = "data:%s;base64,%s" % (mime, base64.b64encode(data).decode("ascii"))
+    for edit in edits:
+        edit(doc)
+    if not glb:
+        with open(out, "w") as fh:
+            json.dump(doc, fh)
+        return
+    bin_chunk = None
+    for i, b in enumerate(doc.get("buffers", [])):
+        if b.get("uri") is None:
+            bin_chunk = buffers[i]
+    js = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    js += b" " * (-len(js) % 4)
+    chunks = struct.pack("<II", len(js), 0x4E4F534A) + js
+    if bin_chunk is not None:
+        bin_chunk = bin_chunk + b"\0" * (-len(bin_chunk) % 4)
+        chunks += struct.pack("<II", len(bin_chunk), 0x004E4942) + bin_chunk
+    with open(out, "wb") as fh:
+        fh.write(struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks)
+
+
+def add_camera(cam):
+    """An edit for copy_gltf: `cam` (a dict like scene["camera"]; znear 0.001) as the document's
+    one camera, on a new root node; ValueError for a document with cameras."""
+    def edit(doc):
+        if doc.get("cameras"):
+            raise ValueError("add_camera: the file has cameras already")
+        f, u = _normalize(cam["forward"]), _normalize(cam["up"])
+        right = _normalize((f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
+                            f[0] * u[1] - f[1] * u[0]))
+        up = (right[1] * f[2] - right[2] * f[1], right[2] * f[0] - right[0] * f[2],
+              right[0] * f[1] - right[1] * f[0])
+        persp = {"yfov": cam["yfov"], "znear": 0.001}
+        if cam.get("aspect"):
+            persp["aspectRatio"] = cam["aspect"]
+        doc["cameras"] = [{"type": "perspective", "perspective": persp}]
+        doc["nodes"].append({"name": "peers_camera", "camera": 0,
+                             "translation": list(cam["position"]),
+                             "rotation": list(_rotation_quaternion(right, up,
+                                                                   tuple(-c for c in f)))})
+        doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 1)
+    return edit
+
+
+NEAREST = 9728  # glTF's (OpenGL's) NEAREST filter
+
+
+def nearest_textures(doc):
+    """An edit for copy_gltf: every texture samples its nearest texel (magFilter and minFilter
+    NEAREST; a texture without a sampler gets one with glTF's default wrapping, REPEAT)."""
+    samplers = doc.setdefault("samplers", [])
+    for s in samplers:
+        s["magFilter"] = s["minFilter"] = NEAREST
+    for t in doc.get("textures", []):
+        if "sampler" not in t:
+            samplers.append({"magFilter": NEAREST, "minFilter": NEAREST})
+            t["sampler"] = len(samplers) - 1
+
+
+def no_normal_maps(doc):
+    """An edit for copy_gltf: no material has a normal texture."""
+    for m in doc.get("materials", []):
+        m.pop("normalTexture", None)
+
+
+def with_camera(path, out, cam):
+    """copy_gltf(path, out, [add_camera(cam)])."""
+    copy_gltf(path, out, [add_camera(cam)])
 
 
 # ---- Summaries (for the test and the report) -----------------------------------------------------
