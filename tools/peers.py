@@ -33,10 +33,14 @@ REPO = os.path.dirname(TOOLS)
 sys.path.insert(0, TOOLS)
 import peers_scene  # noqa: E402
 
-PACKAGES = {"mitsuba": ["mitsuba"], "cycles": ["bpy"]}
+PACKAGES = {"mitsuba": ["mitsuba"], "mitsuba-ld": ["mitsuba"], "cycles": ["bpy"]}
 BASE_PACKAGES = ["numpy", "matplotlib"]
-RENDERERS = ("wavepath", "mitsuba", "cycles")
-LABELS = {"wavepath": "wavepath", "mitsuba": "Mitsuba 3 (llvm_ad_rgb)", "cycles": "Cycles (CPU)"}
+RENDERERS = ("wavepath", "mitsuba", "mitsuba-ld", "cycles")
+LABELS = {"wavepath": "wavepath", "mitsuba": "Mitsuba 3 (llvm_ad_rgb)",
+          "mitsuba-ld": "Mitsuba 3 ldsampler (llvm_ad_rgb)", "cycles": "Cycles (CPU)"}
+# Mitsuba's sampler per renderer key: its default (independent), and its low-discrepancy one
+# (scrambled (0,2)-sequences), the counterpart of wavepath's default Sobol' points.
+MITSUBA_SAMPLERS = {"mitsuba": "independent", "mitsuba-ld": "ldsampler"}
 VENV_MARK = "WP_PEERS_IN_VENV"
 
 DESCRIPTION = """\
@@ -51,8 +55,10 @@ wavepath too: all three render the same purely Lambertian scene.
   Mitsuba 3  PLY meshes, `diffuse` BSDF with the base colour, an `area` emitter (one-sided, front =
              counter-clockwise side, as in wavepath) with the emission as radiance, `point`
              emitters with the intensity in W/sr, a `perspective` sensor (fov_axis y = the
-             glTF yfov), box reconstruction filter (one pixel, wavepath's), `independent`
-             sampler, `path` integrator with max_depth = --max-depth + 1 and rr_depth =
+             glTF yfov), box reconstruction filter (one pixel, wavepath's), the `independent`
+             sampler (renderer `mitsuba`, Mitsuba's default) or `ldsampler` (renderer
+             `mitsuba-ld`: scrambled (0,2)-sequences, like wavepath's default Sobol' points;
+             sample counts must be powers of 2), `path` integrator with max_depth = --max-depth + 1 and rr_depth =
              --rr-depth + 1 (Mitsuba counts path segments from the camera, so max_depth 1 sees
              emitters only and 2 adds direct light; wavepath counts scattering events, so
              wavepath's depth d is Mitsuba's d + 1).
@@ -178,7 +184,8 @@ def worker_mitsuba(job, scene):
                     "near_clip": 1e-3, "far_clip": 1e4,
                     "to_world": mi.ScalarTransform4f().look_at(origin=cam["position"],
                                                                target=target, up=cam["up"]),
-                    "sampler": {"type": "independent", "sample_count": job["spp"]},
+                    "sampler": {"type": job.get("sampler", "independent"),
+                                "sample_count": job["spp"]},
                     "film": {"type": "hdrfilm", "width": job["width"], "height": job["height"],
                              "pixel_format": "rgb", "rfilter": {"type": "box"}}}}
     for k, mesh in enumerate(scene["meshes"]):
@@ -396,7 +403,8 @@ def worker_main(renderer, job_path):
         job = json.load(f)
     with open(job["scene"]) as f:
         scene = json.load(f)
-    {"mitsuba": worker_mitsuba, "cycles": worker_cycles}[renderer](job, scene)
+    {"mitsuba": worker_mitsuba, "mitsuba-ld": worker_mitsuba,
+     "cycles": worker_cycles}[renderer](job, scene)
 
 
 # ---- The sweep -----------------------------------------------------------------------------------
@@ -473,7 +481,7 @@ def parse_args(argv):
     bad = [r for r in a.renderers if r not in RENDERERS]
     if bad:
         p.error("unknown renderer(s) %s" % ", ".join(bad))
-    if a.pbr and "mitsuba" in a.renderers:
+    if a.pbr and ("mitsuba" in a.renderers or "mitsuba-ld" in a.renderers):
         p.error("--pbr: Mitsuba is not converted for glTF materials (--renderers wavepath,cycles)")
     if a.env and not a.pbr:
         p.error("--env needs --pbr (the environment's conversion is verified for that mode only)")
@@ -615,7 +623,7 @@ def run_one(a, renderer, spp, seed, scene_json, env, name=None):
         return t, al.read_pfm(pfm), cpu
     job = {"scene": scene_json, "spp": spp, "seed": seed, "width": a.width, "height": a.height,
            "max_depth": a.max_depth, "rr_depth": a.rr_depth, "out": out,
-           "variant": a.mitsuba_variant}
+           "variant": a.mitsuba_variant, "sampler": MITSUBA_SAMPLERS.get(renderer)}
     job_path = out[:-4] + ".json"
     with open(job_path, "w") as f:
         json.dump(job, f)
@@ -728,7 +736,7 @@ def time_to_target(points, target):
 
 def versions(renderers, env):
     out = {}
-    if "mitsuba" in renderers:
+    if any(r in renderers for r in MITSUBA_SAMPLERS):
         out["mitsuba"] = subprocess.run(
             [sys.executable, "-c", "import mitsuba, drjit; print(mitsuba.__version__, "
              "'(drjit', drjit.__version__ + ')')"],
@@ -1096,7 +1104,7 @@ def main(argv):
     import accuracy_lib as al
 
     env = dict(os.environ)
-    if "mitsuba" in a.renderers and a.mitsuba_variant.startswith("llvm"):
+    if any(r in a.renderers for r in MITSUBA_SAMPLERS) and a.mitsuba_variant.startswith("llvm"):
         llvm = find_libllvm()
         if llvm is None:
             sys.exit("peers.py: error: Mitsuba's %s variant needs libLLVM (Debian: libllvm19; or "
