@@ -10,7 +10,7 @@
 
 /* Roulette for the path in `slot`; a survivor goes to queue_out. Shared by this stage and the
  * fused shade.cl. */
-static inline void roulette(Paths paths, Queues queues, Launch launch, uint slot) {
+WP_STAGE_FN void roulette(Paths paths, Queues queues, Launch launch, uint slot) {
   const float4 beta = paths.throughput[slot];
   if (!all(isfinite(beta))) { /* sample_bsdf catches these first; a NaN is never dropped silently */
     count_nonfinite(queues);

@@ -12,8 +12,8 @@
 
 /* The next ray of the path in `slot` from surface s. Shared by this stage and the fused shade.cl.
  */
-static inline void sample_next_ray(Paths paths, Queues queues, Launch launch, uint slot,
-                                   const Surface* s) {
+WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, Launch launch, uint slot,
+                                 const Surface* s) {
   const Rng rng = path_rng(paths, slot, launch);
   const BsdfSample bs = bsdf_sample(s, -paths.ray_d[slot].xyz, rng_get(rng, WP_DIM_BSDF_LOBE),
                                     rng_get2(rng, WP_DIM_BSDF_U));

@@ -11,8 +11,8 @@
 #if WP_STRATEGY != WP_STRATEGY_BSDF
 /* NEE at surface s of the path in `slot`: a shadow ray into WP_QUEUE_SHADOW. Shared by this stage
  * and the fused shade.cl. */
-static inline void sample_light_ray(const SceneView* scene, Paths paths, Queues queues,
-                                    Launch launch, uint slot, const Surface* s) {
+WP_STAGE_FN void sample_light_ray(const SceneView* scene, Paths paths, Queues queues, Launch launch,
+                                  uint slot, const Surface* s) {
   if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return;
   const Rng rng = path_rng(paths, slot, launch);
   const LightSample ls =

@@ -26,8 +26,8 @@ static inline void aov_record(Paths paths, uint slot, float3 albedo, float3 norm
  * emission and resolves the material into *s. True when the path goes on to scatter at *s (not
  * unlit, fewer than max_depth scattering events so far). Shared by this stage and the fused
  * shade.cl. */
-static inline bool shade_hit(const SceneView* scene, Paths paths, Launch launch, uint slot,
-                             Surface* s) {
+WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, uint slot,
+                           Surface* s) {
   const float4 hit = paths.hit[slot];
   float4 beta = paths.throughput[slot]; /* w: pdf of the BSDF sample (0: delta or camera) */
   const float3 ray_d = paths.ray_d[slot].xyz;
