@@ -5,19 +5,35 @@
 
 #include "common.h"
 
-/* Cosine-weighted hemisphere (concentric disk mapping, then lifted): pdf = cos(theta) / pi. */
+/* (cos t, sin t) for |t| <= pi/4, by their Taylor polynomials to t^10 and t^9: the remainders are
+ * below (pi/4)^12 / 12! = 1.1e-10 and (pi/4)^11 / 11! = 1.8e-9, far under float's rounding, so
+ * the result is as good as cos() and sin(), at a fraction of their cost on PoCL (about 13 ns per
+ * pair there, with their argument reduction). */
+static inline float2 cos_sin_quarter(float t) {
+  const float t2 = t * t;
+  const float c =
+      1.0f +
+      t2 * (-0.5f + t2 * (1.0f / 24.0f + t2 * (-1.0f / 720.0f +
+                                               t2 * (1.0f / 40320.0f - t2 * (1.0f / 3628800.0f)))));
+  const float s =
+      t * (1.0f + t2 * (-1.0f / 6.0f +
+                        t2 * (1.0f / 120.0f + t2 * (-1.0f / 5040.0f + t2 * (1.0f / 362880.0f)))));
+  return (float2)(c, s);
+}
+
+/* Cosine-weighted hemisphere (concentric disk mapping, then lifted): pdf = cos(theta) / pi. The
+ * disk angle is (pi/4) q or pi/2 - (pi/4) q with |q| <= 1, so cos_sin_quarter serves both. */
 static inline float3 sample_cosine_hemisphere(float2 u) {
   const float2 s = 2.0f * u - 1.0f;
-  float r, phi;
   if (s.x == 0.0f && s.y == 0.0f) return (float3)(0.0f, 0.0f, 1.0f);
+  float x, y;
   if (fabs(s.x) > fabs(s.y)) {
-    r = s.x;
-    phi = (WP_PI / 4.0f) * (s.y / s.x);
-  } else {
-    r = s.y;
-    phi = (WP_PI / 2.0f) - (WP_PI / 4.0f) * (s.x / s.y);
+    const float2 cs = cos_sin_quarter((WP_PI / 4.0f) * (s.y / s.x));
+    x = s.x * cs.x, y = s.x * cs.y;
+  } else { /* phi = pi/2 - t: cos phi = sin t, sin phi = cos t */
+    const float2 cs = cos_sin_quarter((WP_PI / 4.0f) * (s.x / s.y));
+    x = s.y * cs.y, y = s.y * cs.x;
   }
-  const float x = r * cos(phi), y = r * sin(phi);
   return (float3)(x, y, sqrt(fmax(0.0f, 1.0f - x * x - y * y)));
 }
 
