@@ -89,8 +89,9 @@ without a camera is rendered by both from a copy with wavepath's framing camera 
              rotation about Z of -(90 + --env-rotation) degrees): the importer turns glTF's +Y
              up into Blender's +Z up, and Blender's equirectangular map has its centre at +X
              where wavepath's has it at glTF's -Z (Blender's +Y). Black world without --env. The
-             camera as above, its vectors turned with the importer's axes. Light tree off.
-             Settings otherwise as above.
+             camera as above, its vectors turned with the importer's axes. Light tree off
+             unless --cycles-light-tree (on DamagedHelmet it was slower and noisier; the
+             commands that measured it are in docs/peers_helmet.md). Settings otherwise as above.
   Errors     The two do not render the same material model (Blender's Principled BSDF is not
              glTF's BRDF: exact dielectric Fresnel and albedo-scaled diffuse, F82 metals,
              MikkTSpace tangents), so each renderer's relMSE is measured against its own
@@ -355,9 +356,7 @@ def worker_cycles_gltf(bpy, job, scene):
     single-scatter GGX, the environment map as the world (see the --help text)."""
     import math
     sc = _cycles_settings(bpy, job)
-    # Measured on DamagedHelmet under empty_warehouse_01_1k.hdr, 256 x 256, 256 spp, 3 seeds:
-    # without the light tree Cycles took 5.6 s against 6.8 s, at relMSE 2.6e-3 against 3.0e-3.
-    sc.cycles.use_light_tree = False
+    sc.cycles.use_light_tree = bool(scene.get("light_tree"))  # --cycles-light-tree
     bpy.ops.import_scene.gltf(filepath=scene["gltf"])
     sc = bpy.context.scene
     for m in bpy.data.materials:
@@ -457,6 +456,9 @@ def parse_args(argv):
     p.add_argument("--env-rotation", type=float, default=0.0,
                    help="rotation of the map about +Y in degrees, wavepath's --env-rotation "
                         "(default 0)")
+    p.add_argument("--cycles-light-tree", action="store_true",
+                   help="--pbr: Cycles samples lights with its light tree (Blender's default; "
+                        "off without this option)")
     p.add_argument("--nearest-textures", action="store_true",
                    help="--pbr, a diagnostic: both render a copy of the file whose samplers are "
                         "all NEAREST (wavepath looks up the nearest texel; Blender's importer makes "
@@ -489,8 +491,8 @@ def parse_args(argv):
         p.error("--env %s: no such file" % a.env)
     if a.repeat < 1:
         p.error("--repeat must be at least 1")
-    if (a.nearest_textures or a.no_normal_maps) and not a.pbr:
-        p.error("--nearest-textures and --no-normal-maps need --pbr")
+    if (a.nearest_textures or a.no_normal_maps or a.cycles_light_tree) and not a.pbr:
+        p.error("--nearest-textures, --no-normal-maps and --cycles-light-tree need --pbr")
     if a.pbr and (a.ref_chunks < 2 or a.ref_spp % a.ref_chunks):
         p.error("--ref-chunks must be at least 2 and divide --ref-spp")
     if not os.access(a.wavepath, os.X_OK):
@@ -567,7 +569,8 @@ def convert_pbr(a):
         peers_scene.copy_gltf(a.scene, a.render_scene, edits)
     scene = {"gltf": os.path.abspath(a.render_scene), "camera": cam,
              "env": os.path.abspath(a.env) if a.env else None,
-             "env_intensity": a.env_intensity, "env_rotation": a.env_rotation}
+             "env_intensity": a.env_intensity, "env_rotation": a.env_rotation,
+             "light_tree": a.cycles_light_tree}
     path = os.path.join(a.work, "scene.json")
     with open(path, "w") as f:
         json.dump(scene, f)
@@ -668,7 +671,8 @@ def cycles_reference(a, scene_json, env):
         with open(f, "rb") as fh:
             h.update(fh.read())
     h.update(json.dumps([a.width, a.height, a.ref_spp, a.ref_chunks, a.max_depth, a.rr_depth,
-                         a.env_intensity, a.env_rotation, versions(["cycles"], env)["cycles"]])
+                         a.env_intensity, a.env_rotation, a.cycles_light_tree,
+                         versions(["cycles"], env)["cycles"]])
              .encode())
     import inspect  # the Cycles worker's code, so that a change to it renders afresh
     for f in (_cycles_settings, _cycles_camera, _cycles_render, worker_cycles,
@@ -1030,12 +1034,12 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "turns Blender's equirectangular convention into wavepath's; checked by the background "
          "pixels below). One-pixel box filter, max bounces = max depth − 1 (Cycles counts "
          "bounces after the first hit), no clamping, no filter glossy, no adaptive sampling, no "
-         "denoising; Cycles' light tree off (on this scene it was both slower and noisier: "
-         "256 spp in 6.8 s at relMSE 3.0·10⁻³ with it, 5.6 s at 2.6·10⁻³ without, mean of 3 "
-         "seeds; the Cornell box page leaves it at Blender's default, on)."
+         "denoising; Cycles' light tree %s (Blender's default is on; the Cornell box page "
+         "leaves it on)."
          % ("The file has no camera: both render a copy with wavepath's framing camera "
             "(45° vertical field of view, the bounding sphere fitted) written into it "
-            "(`peers_scene.with_camera`). " if cam_copy else "")
+            "(`peers_scene.with_camera`). " if cam_copy else "",
+            "on" if a.cycles_light_tree else "off (--cycles-light-tree turns it on)")
          + (" **Both sample every texture at its nearest texel** (--nearest-textures: a copy "
             "of the file with NEAREST samplers, which Blender's importer turns into Closest "
             "interpolation), unlike the file's own (linear) filtering." if a.nearest_textures
@@ -1046,8 +1050,9 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "dielectrics with the exact Fresnel equations (IOR 1.5, the importer's \"Specular IOR "
          "Level\" 0.5) and scales the diffuse base by the specular layer's albedo, where glTF "
          "(and wavepath) mix diffuse and specular with Schlick's Fresnel at the half-vector "
-         "(`kernels/bsdf.h`); its metals use the F82-tint model (with a white tint: Schlick "
-         "with the base colour as F0, as glTF, only up to a small grazing-angle term); the "
+         "(`kernels/bsdf.h`); its metals use the F82-tint model, whose correction to Schlick's "
+         "Fresnel is proportional to one minus the tint, so with the importer's white Specular "
+         "Tint they reflect as glTF's (Schlick, base colour as F0); the "
          "tangent frames of the normal map come from different tangent generators (Blender's "
          "MikkTSpace, wavepath's own, the file has no tangents); the occlusion texture is used "
          "by neither.", "",
@@ -1122,11 +1127,13 @@ def main(argv):
         s = peers_scene.summary(scene)
         log("scene: %d triangles, %d emitters, %d point lights"
             % (s["triangles"], len(s["emitters"]), len(scene["point_lights"])))
-    ref, ref_var, ref_seconds = reference(a)
     # Without --pbr every renderer is measured against wavepath's reference; with it, each
     # against its own.
-    refs = {r: (ref, ref_var) for r in a.renderers}
-    ref_info = {"wavepath": ref_seconds}
+    refs, ref_info = {}, {}
+    if not a.pbr or "wavepath" in a.renderers:
+        ref, ref_var, ref_seconds = reference(a)
+        refs = {r: (ref, ref_var) for r in a.renderers}
+        ref_info = {"wavepath": ref_seconds}
     if a.pbr and "cycles" in a.renderers:
         cimg, cvar, ref_info["cycles"] = cycles_reference(a, scene_json, env)
         refs["cycles"] = (cimg, cvar)
