@@ -1034,12 +1034,13 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "turns Blender's equirectangular convention into wavepath's; checked by the background "
          "pixels below). One-pixel box filter, max bounces = max depth − 1 (Cycles counts "
          "bounces after the first hit), no clamping, no filter glossy, no adaptive sampling, no "
-         "denoising; Cycles' light tree %s (Blender's default is on; the Cornell box page "
-         "leaves it on)."
+         "denoising; Cycles' light tree %s."
          % ("The file has no camera: both render a copy with wavepath's framing camera "
             "(45° vertical field of view, the bounding sphere fitted) written into it "
             "(`peers_scene.with_camera`). " if cam_copy else "",
-            "on" if a.cycles_light_tree else "off (--cycles-light-tree turns it on)")
+            "on (Blender's default)" if a.cycles_light_tree else
+            "off (--cycles-light-tree turns it on, as Blender's default and the Cornell box page "
+            "have it)")
          + (" **Both sample every texture at its nearest texel** (--nearest-textures: a copy "
             "of the file with NEAREST samplers, which Blender's importer turns into Closest "
             "interpolation), unlike the file's own (linear) filtering." if a.nearest_textures
