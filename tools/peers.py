@@ -912,12 +912,19 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
           "ratio to the reference's). The standard error of the ratio is estimated from the "
           "reference's variance image scaled to the run's sample count, assuming a per-sample "
           "variance like wavepath's.", "",
-          "| renderer | spp | R | G | B | ± (1 s.e.) |", "|---|---|---|---|---|---|"]
+          ] + _means_table(a, checks)
+    _write_with_notes(a, L)
+
+
+def _means_table(a, checks):
+    """Rows of the image-mean check: each renderer's largest run over its reference, per
+    channel, with the ratio's standard error."""
+    L = ["| renderer | spp | R | G | B | ± (1 s.e.) |", "|---|---|---|---|---|---|"]
     for r in a.renderers:
         c = checks[r]
         L.append("| %s | %d | %.4f | %.4f | %.4f | %.4f |" % (LABELS[r], c["spp"], *c["ratio"],
                                                              c["se"]))
-    _write_with_notes(a, L)
+    return L
 
 
 def compare_references(refs, masks):
@@ -1075,11 +1082,7 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
           "error of the ratio is estimated from the reference's variance image scaled to the "
           "run's sample count (for wavepath's runs, whose default sampler has less error than "
           "independent samples, an overestimate).", "",
-          "| renderer | spp | R | G | B | ± (1 s.e.) |", "|---|---|---|---|---|---|"]
-    for r in a.renderers:
-        c = checks[r]
-        L.append("| %s | %d | %.4f | %.4f | %.4f | %.4f |" % (LABELS[r], c["spp"], *c["ratio"],
-                                                             c["se"]))
+          ] + _means_table(a, checks)
     if ref_cmp:
         L += ["", "## Conversion check: the two references", "",
               "Cycles' reference against wavepath's: per channel the ratio of the image means "
