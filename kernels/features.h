@@ -61,6 +61,13 @@
 #define WP_MIS_POWER 1
 #endif
 
+/* The work-group size every stage kernel is launched with (the host's --local-size): the kernels
+ * that append to queues do it once per work-group (queues.h, queue_push_group) with a scan in local
+ * memory of this many entries, and require it (WP_GROUP_KERNEL). */
+#ifndef WP_GROUP_SIZE
+#define WP_GROUP_SIZE 64
+#endif
+
 /* AOVs: 1 records each sample's albedo, normal and depth (path_state.def, shade_surface.cl)
  * and adds them to the film (shared/film.h); 0 (the default) compiles none of it. */
 #ifndef WP_AOV

@@ -3,10 +3,10 @@
  * A queue is an array of path-slot indices plus a counter, both in device memory: queue q occupies
  * queues[q * capacity ...] and its length is counters[q]. The invariant: at any kernel boundary,
  * counters[q] <= capacity and entries [0, counters[q]) are distinct live slots. Producers append
- * with an atomic increment (order is therefore arbitrary, and nothing may depend on it: every
- * result is a function of the slot's own state and its stateless random numbers). Consumers are
- * launched over an upper bound of the length and return past counters[q], so the host never has to
- * read a counter back to launch the next stage. Every kernel moves a slot to at most one next
+ * with an atomic add per work-group (order is therefore arbitrary, and nothing may depend on it:
+ * every result is a function of the slot's own state and its stateless random numbers). Consumers
+ * are launched over an upper bound of the length and return past counters[q], so the host never has
+ * to read a counter back to launch the next stage. Every kernel moves a slot to at most one next
  * queue, or ends the path there.
  */
 #ifndef WP_QUEUES_H
@@ -32,10 +32,38 @@ static inline bool queue_get(Queues qs, uint q, uint index, uint* slot) {
   return true;
 }
 
-static inline void queue_push(Queues qs, uint q, uint slot) {
-  const uint at = atomic_inc(&qs.counters[q]);
-  qs.slots[q * qs.capacity + at] = slot;
+/* Appends `slot` to queue `q` where `push` holds, for the whole work-group at once: a scan of the
+ * group's flags in local memory, one atomic add on the queue's counter per group, and each pushing
+ * work-item writes its entry at the group's base plus its rank. One atomic per work-item instead
+ * cost half the time of shade_surface and roulette_compact on PoCL (a locked add on a counter the
+ * other cores share, which also waits for the work-item's earlier stores to drain).
+ *
+ * It holds barriers: every work-item of the group must call it, in the same order as the others,
+ * none having returned before. `scan` is the kernel's WP_GROUP_SCRATCH (WP_GROUP_SIZE + 1 words).
+ * The rank is the work-item's order in its group, so a queue's order still depends on which group
+ * reached the counter first (nothing may depend on it; see the top of this file). */
+static inline void queue_push_group(Queues qs, uint q, bool push, uint slot, __local uint* scan) {
+  const uint lid = get_local_id(0);
+  scan[lid] = push ? 1u : 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (lid == 0u) { /* serial, by one work-item: a CPU runs the group as one loop anyway */
+    uint total = 0u;
+    for (uint i = 0u; i < WP_GROUP_SIZE; ++i) {
+      const uint flag = scan[i];
+      scan[i] = total;
+      total += flag;
+    }
+    scan[WP_GROUP_SIZE] = total ? atomic_add(&qs.counters[q], total) : 0u;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (push) qs.slots[q * qs.capacity + scan[WP_GROUP_SIZE] + scan[lid]] = slot;
 }
+
+/* A stage kernel that pushes to queues: launched with exactly WP_GROUP_SIZE work-items per group,
+ * which its local scan (WP_GROUP_SCRATCH) is sized for. */
+#define WP_GROUP_KERNEL __kernel __attribute__((reqd_work_group_size(WP_GROUP_SIZE, 1, 1)))
+/* The local memory of queue_push_group, declared at the top of such a kernel. */
+#define WP_GROUP_SCRATCH(name) __local uint name[WP_GROUP_SIZE + 1]
 
 /* Counts a NaN or infinite value that a stage drops (it must never happen; the renderer reports
  * the count and the tests require 0). Every place that drops such a value counts it, so that no

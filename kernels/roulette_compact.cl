@@ -8,31 +8,34 @@
 #include "stage.h"
 #include "surface.h"
 
-/* Roulette for the path in `slot`; a survivor goes to queue_out. Shared by this stage and the
- * fused shade.cl. */
-WP_STAGE_FN void roulette(Paths paths, Queues queues, Launch launch, uint slot) {
+/* Roulette for the path in `slot`: true for a survivor, which the caller pushes to queue_out.
+ * Shared by this stage and the fused shade.cl. */
+WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot) {
   const float4 beta = paths.throughput[slot];
   if (!all(isfinite(beta))) { /* sample_bsdf catches these first; a NaN is never dropped silently */
     count_nonfinite(queues);
-    return;
+    return false;
   }
-  if (!(max3(beta.xyz) > 0.0f)) return;
+  if (!(max3(beta.xyz) > 0.0f)) return false;
   /* Survival looks at the throughput without the 1/eta^2 factors of refraction (pbrt-v4's
    * etaScale): inside glass they would otherwise end paths that are about to leave it, where
    * the factor is undone. */
   const float m = max3(beta.xyz) * paths.radiance[slot].w;
   const uint bounce = paths.info[slot].y;
   if (bounce + 1u >= launch.rr_depth && m < 1.0f) {
-    if (rng_get(path_rng(paths, slot, launch), WP_DIM_ROULETTE) >= m) return;
+    if (rng_get(path_rng(paths, slot, launch), WP_DIM_ROULETTE) >= m) return false;
     paths.throughput[slot] = (float4)(beta.xyz / m, beta.w);
   }
   paths.info[slot].y = bounce + 1u;
-  queue_push(queues, launch.queue_out, slot);
+  return true;
 }
 
-__kernel void roulette_compact(WP_STAGE_PARAMS) {
+WP_GROUP_KERNEL void roulette_compact(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
-  roulette(paths, queues, launch, slot);
+  WP_GROUP_SCRATCH(scan);
+  uint slot = 0u;
+  bool survives = false;
+  if (queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot))
+    survives = roulette(paths, queues, launch, slot);
+  queue_push_group(queues, launch.queue_out, survives, slot, scan);
 }

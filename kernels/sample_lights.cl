@@ -9,24 +9,24 @@
 #include "surface.h"
 
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-/* NEE at surface s of the path in `slot`: a shadow ray into WP_QUEUE_SHADOW. Shared by this stage
- * and the fused shade.cl. */
-WP_STAGE_FN void sample_light_ray(const SceneView* scene, Paths paths, Queues queues, Launch launch,
+/* NEE at surface s of the path in `slot`: a shadow ray for WP_QUEUE_SHADOW, true when there is one
+ * (the caller pushes it). Shared by this stage and the fused shade.cl. */
+WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues queues, Launch launch,
                                   uint slot, const Surface* s) {
-  if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return;
+  if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return false;
   const Rng rng = path_rng(paths, slot, launch);
   const LightSample ls =
       sample_light(scene, s->p, rng_get(rng, WP_DIM_LIGHT_PICK), rng_get2(rng, WP_DIM_LIGHT_U));
-  if (!(ls.pdf > 0.0f)) return;
+  if (!(ls.pdf > 0.0f)) return false;
   const BsdfEval e = bsdf_eval(s, -paths.ray_d[slot].xyz, ls.wi);
   const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
   const float3 c =
       paths.throughput[slot].xyz * e.f * ls.li * (fabs(dot(s->ns, ls.wi)) * w / ls.pdf);
   if (!all(isfinite(c))) {
     count_nonfinite(queues);
-    return;
+    return false;
   }
-  if (!(max3(c) > 0.0f)) return;
+  if (!(max3(c) > 0.0f)) return false;
   /* The shadow ray leaves the side of the surface the light is on (transmission can light the
    * back) and, for a light at a finite distance, runs from the moved origin to the light's target
    * point (itself moved off an area light's surface): neither end can hit the surface it is on. */
@@ -43,16 +43,20 @@ WP_STAGE_FN void sample_light_ray(const SceneView* scene, Paths paths, Queues qu
    * count may have moved on, in the fused pipeline). */
   paths.shadow_d[slot] = (float4)(dir, as_float(paths.info[slot].y));
   paths.shadow_l[slot] = (float4)(c, 0.0f);
-  queue_push(queues, WP_QUEUE_SHADOW, slot);
+  return true;
 }
 #endif
 
-__kernel void sample_lights(WP_STAGE_PARAMS) {
+WP_GROUP_KERNEL void sample_lights(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-  const Surface s = surface_load(paths, slot);
-  sample_light_ray(&scene, paths, queues, launch, slot, &s);
+  WP_GROUP_SCRATCH(scan);
+  uint slot = 0u;
+  bool shadow = false;
+  if (queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) {
+    const Surface s = surface_load(paths, slot);
+    shadow = sample_light_ray(&scene, paths, queues, launch, slot, &s);
+  }
+  queue_push_group(queues, WP_QUEUE_SHADOW, shadow, slot, scan);
 #endif
 }

@@ -12,15 +12,22 @@
 #include "stage.h"
 #include "surface.h"
 
-__kernel void shade(WP_STAGE_PARAMS) {
+WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
+  WP_GROUP_SCRATCH(scan);
+  uint slot = 0u;
+  bool shadow = false, survives = false;
   Surface s;
-  if (!shade_hit(&scene, paths, launch, slot, &s)) return;
+  if (queue_get(queues, launch.queue_in, get_global_id(0), &slot) &&
+      shade_hit(&scene, paths, launch, slot, &s)) {
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-  sample_light_ray(&scene, paths, queues, launch, slot, &s);
+    shadow = sample_light_ray(&scene, paths, queues, launch, slot, &s);
 #endif
-  sample_next_ray(paths, queues, launch, slot, &s);
-  roulette(paths, queues, launch, slot);
+    sample_next_ray(paths, queues, launch, slot, &s);
+    survives = roulette(paths, queues, launch, slot);
+  }
+#if WP_STRATEGY != WP_STRATEGY_BSDF
+  queue_push_group(queues, WP_QUEUE_SHADOW, shadow, slot, scan);
+#endif
+  queue_push_group(queues, launch.queue_out, survives, slot, scan);
 }

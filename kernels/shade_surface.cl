@@ -78,12 +78,15 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   return paths.info[slot].y < launch.max_depth;
 }
 
-__kernel void shade_surface(WP_STAGE_PARAMS) {
+WP_GROUP_KERNEL void shade_surface(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
-  uint slot;
-  if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
-  Surface s;
-  if (!shade_hit(&scene, paths, launch, slot, &s)) return;
-  surface_store(paths, slot, &s);
-  queue_push(queues, WP_QUEUE_SURFACE, slot);
+  WP_GROUP_SCRATCH(scan);
+  uint slot = 0u;
+  bool scatters = false;
+  if (queue_get(queues, launch.queue_in, get_global_id(0), &slot)) {
+    Surface s;
+    scatters = shade_hit(&scene, paths, launch, slot, &s);
+    if (scatters) surface_store(paths, slot, &s);
+  }
+  queue_push_group(queues, WP_QUEUE_SURFACE, scatters, slot, scan);
 }

@@ -415,7 +415,7 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
     for (float v : reference) sum += v;
     EXPECT_GT(sum, 0.0);
     for (const auto& [wave, local] : std::vector<std::pair<std::size_t, std::size_t>>{
-             {0, 0}, {1000, 0}, {777, 8}, {0, 64}, {256, 32}}) {
+             {0, 0}, {1000, 0}, {777, 8}, {0, 64}, {256, 32}, {333, 1}, {0, 256}}) {
       st.wave_size = wave;
       st.local_size = local;
       const auto image = wp::render(*runtime_, s, st).image.rgb;
