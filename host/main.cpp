@@ -44,7 +44,7 @@ struct CliOptions {
   std::string heuristic = "power";
   std::string light_select = "power";
   std::string sampler = "sobol";
-  std::string pipeline = "split";
+  std::string pipeline = "fused";
   bool no_rr = false;
   bool variance = false;
   bool no_bvh_cache = false;

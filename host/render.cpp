@@ -178,7 +178,7 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.kernel_build_seconds = wavefront.build_seconds();
   r.kernel_binary_bytes = wavefront.binary_bytes();
   r.setup_seconds = since(start);
-  r.wave_size = wavefront.wave_size();
+  r.wave_size = wavefront.wave_paths();
   r.bytes_per_path = wavefront.path_state().bytes_per_path;
   r.scene_bytes = wavefront.scene_bytes();
   r.scene_buffers = wavefront.scene_buffer_count();
@@ -232,7 +232,14 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
       }
     }
     // The absolute sample index: the random numbers of sample s are the same in every part.
-    wavefront.render_pass(next++);
+    // A pass renders as many samples as a wave holds (several for a small image), but stops at
+    // the next noise check, so that the checks, and where they stop, do not depend on it.
+    std::uint32_t samples = std::min<std::uint32_t>(
+        static_cast<std::uint32_t>(wavefront.samples_per_wave()), end - next);
+    if (options.noise_threshold > 0 && next_check > next)
+      samples = std::min(samples, next_check - next);
+    wavefront.render_pass(next, samples);
+    next += samples;
     if (r.passes++ == 0) r.first_pass_seconds = since(start);
     if (options.progress)
       options.progress(int(next - begin), settings.spp, since(passes_start), r.passes);

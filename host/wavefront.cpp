@@ -57,7 +57,12 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
                      const RenderSettings& settings)
     : rt_(runtime), settings_(settings) {
   const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
+  // A wave holds up to 2^20 pixels of one sample; a smaller image gets several samples per wave,
+  // up to about kMultiSamplePaths paths (or the --wave-size asked for), so that its passes are
+  // not mostly kernel launches on a few rays (the last bounces).
   wave_size_ = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
+  const std::size_t multi = settings.wave_size ? settings.wave_size : kMultiSamplePaths;
+  samples_per_wave_ = std::max<std::size_t>(1, multi / wave_size_);
   // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
   // of it) and compiles every kernel again for each new one, seconds each time.
   local_size_ = settings.local_size ? settings.local_size : 64;
@@ -65,7 +70,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   features_ =
       settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
   options_ = program_options(features_, settings, bvh.width, local_size_);
-  path_state_ = path_state_layout(wave_size_, settings.aov);
+  path_state_ = path_state_layout(wave_paths(), settings.aov);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
 
@@ -96,7 +101,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     if (in_place) packed_ = std::move(packed.buffers);
     path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
     queue_slots_ =
-        cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_size_ * sizeof(dev::uint));
+        cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_paths() * sizeof(dev::uint));
     counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
     const std::size_t film_words = pixels * WP_FILM_WORDS(settings.aov);
     film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
@@ -192,23 +197,24 @@ std::uint32_t Wavefront::read_counter(std::uint32_t index) {
 }
 
 void Wavefront::write_queue(dev::uint queue, const std::vector<dev::uint>& slots) {
-  if (slots.size() > wave_size_) throw Error("write_queue: more slots than the wave holds");
+  if (slots.size() > wave_paths()) throw Error("write_queue: more slots than the wave holds");
   std::vector<dev::uint> counters(WP_QUEUE_COUNT, 0u);
   counters[queue] = static_cast<dev::uint>(slots.size());
   rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
                                  counters.data());
   if (!slots.empty())
-    rt_.queue().enqueueWriteBuffer(queue_slots_, CL_TRUE, queue * wave_size_ * sizeof(dev::uint),
+    rt_.queue().enqueueWriteBuffer(queue_slots_, CL_TRUE, queue * wave_paths() * sizeof(dev::uint),
                                    slots.size() * sizeof(dev::uint), slots.data());
 }
 
 dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_pixel,
-                                     std::uint32_t count) const {
+                                     std::uint32_t count, std::uint32_t samples) const {
   dev::Launch p{};
   p.width = static_cast<dev::uint>(settings_.width);
   p.height = static_cast<dev::uint>(settings_.height);
   p.pixel_offset = first_pixel;
-  p.path_count = count;
+  p.wave_pixels = count;
+  p.path_count = count * samples;
   p.sample = sample;
   p.seed = settings_.seed;
   p.max_depth = static_cast<dev::uint>(settings_.max_depth);
@@ -217,9 +223,10 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
 }
 
 // One wave of paths through all bounces: the algorithm, one named call per stage.
-void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count) {
-  dev::Launch p = start_wave(sample, first_pixel, count);
-  for (std::uint32_t rays = count; rays > 0;) {
+void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                         std::uint32_t samples) {
+  dev::Launch p = start_wave(sample, first_pixel, count, samples);
+  for (std::uint32_t rays = p.path_count; rays > 0;) {
     rays_traced_ += rays;
     rays = run_bounce(p, rays);
   }
@@ -227,10 +234,10 @@ void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::u
 }
 
 dev::Launch Wavefront::start_wave(std::uint32_t sample, std::uint32_t first_pixel,
-                                  std::uint32_t count) {
-  dev::Launch p = launch_params(sample, first_pixel, count);
+                                  std::uint32_t count, std::uint32_t samples) {
+  dev::Launch p = launch_params(sample, first_pixel, count, samples);
   p.queue_out = WP_QUEUE_RAY_A;
-  launch(Stage::kGenerateCameraRays, count, p);
+  launch(Stage::kGenerateCameraRays, p.path_count, p);
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
   return p;
@@ -265,7 +272,7 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
 Wavefront::Snapshot Wavefront::snapshot() {
   Snapshot s;
   s.paths.resize(path_state_.bytes);
-  s.slots.resize(WP_QUEUE_COUNT * wave_size_);
+  s.slots.resize(WP_QUEUE_COUNT * wave_paths());
   s.counters.resize(WP_COUNTER_COUNT);
   auto& q = rt_.queue();
   q.enqueueReadBuffer(path_buf_, CL_FALSE, 0, s.paths.size(), s.paths.data());
@@ -285,12 +292,15 @@ void Wavefront::restore(const Snapshot& s) {
                        s.counters.data());
 }
 
-void Wavefront::render_pass(std::uint32_t sample) {
+void Wavefront::render_pass(std::uint32_t sample, std::uint32_t samples) {
+  if (samples < 1 || samples > samples_per_wave_)
+    throw Error("render_pass: the samples of a pass must fit one wave");
   const std::uint32_t pixels = static_cast<std::uint32_t>(settings_.width * settings_.height);
   try {
     for (std::uint32_t first = 0; first < pixels; first += static_cast<std::uint32_t>(wave_size_))
       run_wave(sample, first,
-               std::min<std::uint32_t>(static_cast<std::uint32_t>(wave_size_), pixels - first));
+               std::min<std::uint32_t>(static_cast<std::uint32_t>(wave_size_), pixels - first),
+               samples);
     rt_.queue().finish();
   } catch (const cl::Error& e) {
     rethrow_cl(e, "rendering on " + rt_.device().name);

@@ -53,20 +53,30 @@ struct RenderSettings {
   MisHeuristic mis_heuristic = MisHeuristic::kPower;
   LightSelect light_select = LightSelect::kPower;
   Sampler sampler = Sampler::kSobol;
-  int camera = -1;             // index into Scene::cameras; -1: the first, or a framing camera
-  bool all_features = false;   // build every kernel feature regardless of the scene
-  std::size_t wave_size = 0;   // path slots per wave; 0: min(pixels, 2^20)
+  int camera = -1;            // index into Scene::cameras; -1: the first, or a framing camera
+  bool all_features = false;  // build every kernel feature regardless of the scene
+  // Path slots per wave; 0: min(pixels, 2^20), or for an image of fewer than kMultiSamplePaths
+  // pixels, as many whole samples of it as fit in kMultiSamplePaths. A size above the pixel count
+  // also holds several samples (its quotient by the pixel count).
+  std::size_t wave_size = 0;
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
   // One fused kernel per bounce for everything at a hit (kernels/shade.cl), or the split stages
   // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit.
-  // Split by default: on PoCL the fused kernel measured no faster (README, "Fused shading").
-  bool fused = false;
+  // Fused by default: on PoCL it measured 10% faster on the Cornell box (README, "Fused shading").
+  bool fused = true;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Most bytes in one scene buffer (device_scene.h); 0: the device's largest allocation. Smaller
   // values split even small scenes over several buffers (tests).
   std::uint64_t scene_buffer_bytes = 0;
 };
+
+// The paths a wave of a small image holds by default (RenderSettings::wave_size): fewer waves
+// per sample, so fewer launches that trace only the last bounces' few rays. On the Lambertian
+// Cornell box, 128 x 128 x 256 spp on PoCL, waves of 2^14 paths took 2.15-2.32 s, 2^16 1.78-2.09 s,
+// 2^18 1.88-2.00 s, and in a second sweep 2^16 1.86-2.12 s, 2^18 1.98-2.02 s (README, "Waves of
+// several samples"). Equal here; 2^18 for a GPU, which keeps about that many threads in flight.
+constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 
 // The most bytes of one scene buffer on `device` with `settings`.
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
@@ -84,8 +94,9 @@ class Wavefront {
   Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
             const RenderSettings& settings);
 
-  // Renders sample index `sample` for every pixel and adds it to the film.
-  void render_pass(std::uint32_t sample);
+  // Renders sample indices [sample, sample + samples) for every pixel and adds them to the film;
+  // 1 <= samples <= samples_per_wave().
+  void render_pass(std::uint32_t sample, std::uint32_t samples = 1);
   // The device film read back: the sums of every pass rendered so far, which `info` describes
   // (its size must be the settings'; its sample range is the passes', as the caller knows them).
   Film film(FilmInfo info);
@@ -123,7 +134,8 @@ class Wavefront {
   // the camera rays of a wave and returns the launch parameters of its first bounce; run_bounce
   // runs one bounce's stages on `rays` queued rays and returns the next bounce's count, leaving
   // `params` ready for it.
-  dev::Launch start_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count);
+  dev::Launch start_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                         std::uint32_t samples = 1);
   std::uint32_t run_bounce(dev::Launch& params, std::uint32_t rays);
   // The whole mutable device state except the film (path state, queues, counters), to replay a
   // stage on the same input many times.
@@ -136,15 +148,19 @@ class Wavefront {
   std::uint32_t counter(std::uint32_t index) { return read_counter(index); }
   // Replaces queue `queue` (WP_QUEUE_*) with `slots` and sets its counter; zeroes the others.
   void write_queue(dev::uint queue, const std::vector<dev::uint>& slots);
-  // Launch parameters of sample `sample` for the wave starting at `first_pixel`.
-  dev::Launch launch_params(std::uint32_t sample, std::uint32_t first_pixel,
-                            std::uint32_t count) const;
+  // Launch parameters of the wave of `count` pixels from `first_pixel`, `samples` samples of each
+  // from index `sample`.
+  dev::Launch launch_params(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                            std::uint32_t samples = 1) const;
   void finish() { rt_.queue().finish(); }
 
   const SceneFeatures& features() const { return features_; }
   const LightTable& lights() const { return lights_; }
   const PathStateLayout& path_state() const { return path_state_; }
+  // Pixels per wave (one sample of each, or samples_per_wave() of them), and path slots per wave.
   std::size_t wave_size() const { return wave_size_; }
+  std::size_t samples_per_wave() const { return samples_per_wave_; }
+  std::size_t wave_paths() const { return wave_size_ * samples_per_wave_; }
   const StageTimes& stage_times() const { return times_; }
   std::string build_options() const { return options_; }
   // FNV-1a 64 of the program's source (all stage kernels, includes expanded): part of the render
@@ -157,7 +173,8 @@ class Wavefront {
   std::size_t binary_bytes() const { return binary_bytes_; }
 
  private:
-  void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count);
+  void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                std::uint32_t samples);
   cl::Event launch(Stage stage, std::uint32_t items, const dev::Launch& params);
   std::uint32_t read_counter(std::uint32_t index);
   void collect_profile();
@@ -169,6 +186,7 @@ class Wavefront {
   LightTable lights_;
   PathStateLayout path_state_;
   std::size_t wave_size_ = 0;
+  std::size_t samples_per_wave_ = 1;
   std::size_t local_size_ = 0;
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;

@@ -48,20 +48,24 @@ static inline void film_add_aovs(__global ulong* px, float4 albedo, float4 norma
 }
 #endif
 
+/* One work-item per pixel of the wave, adding each of the wave's samples of it in turn (slots
+ * i, i + wave_pixels, ...: stage.h, path_sample), so no two work-items write one pixel. */
 __kernel void accumulate(WP_STAGE_PARAMS, __global ulong* film) {
   WP_STAGE_BIND;
-  const uint slot = get_global_id(0);
-  if (slot >= launch.path_count) return;
-  __global ulong* px = film + (size_t)paths.info[slot].x * WP_FILM_STRIDE;
+  const uint first = get_global_id(0);
+  if (first >= launch.wave_pixels) return;
+  __global ulong* px = film + (size_t)paths.info[first].x * WP_FILM_STRIDE;
+  for (uint slot = first; slot < launch.path_count; slot += launch.wave_pixels) {
 #if WP_AOV /* every sample once, also one whose radiance is dropped below */
-  film_add_aovs(px, paths.aov_albedo[slot], paths.aov_normal[slot]);
+    film_add_aovs(px, paths.aov_albedo[slot], paths.aov_normal[slot]);
 #endif
-  const float3 l = paths.radiance[slot].xyz;
-  if (!all(isfinite(l))) {
-    count_nonfinite(queues);
-    return;
+    const float3 l = paths.radiance[slot].xyz;
+    if (!all(isfinite(l))) {
+      count_nonfinite(queues);
+      continue;
+    }
+    film_add_value(px, 0u, l.x);
+    film_add_value(px, 1u, l.y);
+    film_add_value(px, 2u, l.z);
   }
-  film_add_value(px, 0u, l.x);
-  film_add_value(px, 1u, l.y);
-  film_add_value(px, 2u, l.z);
 }

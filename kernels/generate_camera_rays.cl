@@ -9,9 +9,10 @@ __kernel void generate_camera_rays(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
   const uint slot = get_global_id(0);
   if (slot >= launch.path_count) return;
-  const uint pixel = launch.pixel_offset + slot;
+  const uint pixel = launch.pixel_offset + slot % launch.wave_pixels;
   const uint px = pixel % launch.width, py = pixel / launch.width;
-  const float2 jitter = rng_get2(rng_make(pixel, launch.sample, launch.seed, 0u), WP_DIM_PIXEL_X);
+  const float2 jitter =
+      rng_get2(rng_make(pixel, path_sample(launch, slot), launch.seed, 0u), WP_DIM_PIXEL_X);
   const float2 ndc = (float2)(2.0f * ((float)px + jitter.x) / (float)launch.width - 1.0f,
                               1.0f - 2.0f * ((float)py + jitter.y) / (float)launch.height);
   float3 o, d;

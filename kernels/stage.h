@@ -20,10 +20,20 @@
   const Paths paths = paths_bind(path_buf, path_layout); \
   const Queues queues = queues_bind(queue_slots, queue_counters, path_layout.capacity)
 
+/* The sample index of the path in `slot`: a wave holds one or more samples of its pixels, one after
+ * another (Launch.wave_pixels). */
+static inline uint path_sample(Launch launch, uint slot) {
+  return launch.sample + slot / launch.wave_pixels;
+}
+
+/* The random numbers of the path in `slot` at bounce `bounce`. */
+static inline Rng path_rng_at(Paths paths, uint slot, Launch launch, uint bounce) {
+  return rng_make(paths.info[slot].x, path_sample(launch, slot), launch.seed, bounce);
+}
+
 /* The random numbers of the path in `slot` at its current bounce. */
 static inline Rng path_rng(Paths paths, uint slot, Launch launch) {
-  const uint4 info = paths.info[slot];
-  return rng_make(info.x, launch.sample, launch.seed, info.y);
+  return path_rng_at(paths, slot, launch, paths.info[slot].y);
 }
 
 #endif /* WP_STAGE_H */

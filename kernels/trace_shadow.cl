@@ -25,8 +25,7 @@ __kernel void trace_shadow(WP_STAGE_PARAMS) {
   const float4 dw = paths.shadow_d[slot];
   const float3 d = dw.xyz;
   /* The random numbers of the bounce that made the ray (shadow_d.w, sample_lights.cl). */
-  const uint key = rng_bits(rng_make(paths.info[slot].x, launch.sample, launch.seed, as_uint(dw.w)),
-                            WP_DIM_ALPHA_SHADOW);
+  const uint key = rng_bits(path_rng_at(paths, slot, launch, as_uint(dw.w)), WP_DIM_ALPHA_SHADOW);
 #if WP_FEATURE_TRANSMISSION
   const bool finite = o.w < INFINITY;
   const float3 target = o.xyz + d * o.w; /* the end point of a ray of finite length */

@@ -135,16 +135,22 @@ models=$assets/models
 # In the repository: both BVH layouts, all features, several waves of several work-groups (and a
 # partial last group), an environment map, glass and mirrors, punctual lights, degenerate
 # triangles, scenes split over several scene buffers (3 each, --json's scene_buffers), AOVs,
-# the fused shading kernel and the independent sampler.
+# waves of several samples, the split stage kernels (the fused shade kernel is the default) and
+# the independent sampler.
 check cornell_bvh2 "$scenes/cornell_box.gltf" --bvh-width 2
-check cornell_bvh8_all "$scenes/cornell_box.gltf" --bvh-width 8 --features all --local-size 16
+check cornell_bvh8_all "$scenes/cornell_box.gltf" --bvh-width 8 --features all --local-size 16 \
+  --pipeline split
 check point_waves "$scenes/cornell_box_point.gltf" --bvh-width 8 --spp 2 --wave-size 20 \
   --local-size 16
+check cornell_samples_per_wave "$scenes/cornell_box.gltf" --bvh-width 8 --spp 3 --wave-size 100 \
+  --pipeline split
 check cornell_split "$scenes/cornell_box.gltf" --bvh-width 8 --scene-buffer-kib 4
 check env_sun_split "$scenes/failure/env_sun.gltf" --env "$scenes/failure/env_sun.hdr" \
   --bvh-width 2 --scene-buffer-kib 2048
 check caustics "$scenes/failure/caustics.gltf" --bvh-width 8 --aov albedo,normal,depth
-check punctual "$scenes/failure/punctual.gltf" --bvh-width 8 --features all
+check caustics_split "$scenes/failure/caustics.gltf" --bvh-width 2 --aov albedo,normal,depth \
+  --pipeline split
+check punctual "$scenes/failure/punctual.gltf" --bvh-width 8 --features all --pipeline split
 check punctual_fused "$scenes/failure/punctual.gltf" --bvh-width 2 --features all \
   --pipeline fused --sampler independent
 check degenerate "$scenes/failure/degenerate.gltf" --bvh-width 2 --local-size 16

@@ -98,11 +98,15 @@ class StopResume : public wp::test::FolderTest {
 
 // The first pass of a render always runs; no later one starts once the limit has passed. 1 ms
 // passes before the first pass ends (loading and the OpenCL set-up alone take longer), so
-// exactly one sample is rendered.
+// exactly one pass is rendered: the samples one wave holds (wave_size paths over the image's 384
+// pixels, several for an image this small).
 TEST_F(StopResume, TimeLimitAlwaysRendersTheFirstPass) {
   const CliRun r = run(scene_args() + "--spp 1000 --time-limit 0.001 --json -q -o t.pfm");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(json_number(r.out, "spp"), 1) << r.out;
+  EXPECT_EQ(json_number(r.out, "passes"), 1) << r.out;
+  const double per_wave = std::floor(json_number(r.out, "wave_size") / 384);
+  EXPECT_GT(per_wave, 1) << r.out;
+  EXPECT_EQ(json_number(r.out, "spp"), std::min(per_wave, 1000.0)) << r.out;
   EXPECT_NE(r.out.find("\"stop\":\"time_limit\""), std::string::npos) << r.out;
   EXPECT_EQ(json_number(r.out, "spp_requested"), 1000) << r.out;
 }
@@ -225,11 +229,13 @@ TEST_F(StopResume, InterruptedRenderKeepsItsWorkAndResumesExactly) {
   EXPECT_EQ(wp::read_exr_attributes(path("img.exr")).at("wavepath:stop"), "interrupted");
 
   // The image written is the checkpoint's; going on to done + 7 samples from it (replacing the
-  // checkpoint as it goes) equals one render of done + 7 samples.
+  // checkpoint as it goes) equals one render of done + 7 samples. A wave of the image's 384
+  // pixels holds one sample, so the 7 new samples take 7 passes (a restart would take done + 7).
   expect_same_as_render_of(done, "img.pfm", "ck.wpfilm");
   const std::string more = std::to_string(done + 7);
   const CliRun r = run(scene_args() + "--spp " + more +
-                       " --resume ck.wpfilm --checkpoint ck.wpfilm --json -q -o res.pfm");
+                       " --wave-size 384 --resume ck.wpfilm --checkpoint ck.wpfilm --json -q -o "
+                       "res.pfm");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(json_number(r.out, "passes"), 7) << r.out;
   EXPECT_EQ(json_number(r.out, "spp"), done + 7) << r.out;
@@ -286,9 +292,11 @@ TEST_F(StopResume, BadOptionValues) {
 }
 
 // Without a terminal (here a file), one progress line per --progress-every seconds; with 0, one
-// per pass; then the summary naming every file written. --quiet prints nothing.
+// per pass (here one sample each: a wave of the image's 384 pixels); then the summary naming every
+// file written. --quiet prints nothing.
 TEST_F(StopResume, ProgressLinesInALog) {
-  const CliRun r = run(scene_args() + "--spp 5 --progress-every 0 -o a.pfm -o b.exr");
+  const CliRun r =
+      run(scene_args() + "--spp 5 --wave-size 384 --progress-every 0 -o a.pfm -o b.exr");
   ASSERT_EQ(r.status, 0) << r.err;
   for (int i = 1; i <= 5; ++i)
     EXPECT_NE(r.err.find("wavepath: " + std::to_string(i) + "/5 spp ("), std::string::npos)

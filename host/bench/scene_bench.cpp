@@ -115,7 +115,7 @@ StageJob SceneBench::stage_job(Stage stage, int b) {
 Wavefront& SceneBench::render_wavefront() {
   if (!render_) {
     render_ = std::make_unique<Wavefront>(*env().runtime, scene_, bvh_, bench_settings(true));
-    render_->render_pass(next_sample());  // first-touch costs stay out of the figures
+    render_->render_pass(next_samples());  // first-touch costs stay out of the figures
   }
   return *render_;
 }

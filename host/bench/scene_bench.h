@@ -60,7 +60,11 @@ class SceneBench {
 
   // The end-to-end Wavefront, with profiling, after one untimed warm-up pass.
   Wavefront& render_wavefront();
-  std::uint32_t next_sample() { return next_sample_++; }
+  // The first of the next `count` sample indices (each bench pass renders new samples).
+  std::uint32_t next_samples(std::uint32_t count = 1) {
+    next_sample_ += count;
+    return next_sample_ - count;
+  }
   // The sum of the device buffers a Wavefront allocates for this scene: scene, path state,
   // queues, counters, film.
   std::size_t device_memory_bytes();

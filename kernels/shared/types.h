@@ -162,15 +162,16 @@ typedef struct PathLayout {
 typedef struct Launch {
   uint width, height; /* image size in pixels */
   uint pixel_offset;  /* first pixel of this wave (pixels are numbered row by row) */
-  uint path_count;    /* pixels in this wave (<= the path capacity) */
-  uint sample;        /* sample index of this pass, 0..spp-1 */
+  uint path_count;    /* paths in this wave (<= the path capacity): wave_pixels x its samples */
+  uint sample;        /* the wave's first sample index (0..spp-1) */
   uint seed;          /* user seed */
   uint bounce;        /* 0 for camera rays */
   uint max_depth;     /* paths end after this many scattering events */
   uint rr_depth;      /* Russian roulette from this bounce on; >= max_depth: never */
   uint queue_in;      /* WP_QUEUE_* the stage reads */
   uint queue_out;     /* WP_QUEUE_* the stage appends to */
-  uint pad0;
+  uint wave_pixels; /* pixels in this wave: path slot i renders pixel pixel_offset + i % wave_pixels
+                       at sample index sample + i / wave_pixels (stage.h, path_sample) */
 } Launch;
 
 WP_DEV_END
