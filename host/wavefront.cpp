@@ -256,15 +256,23 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
   launch(Stage::kIntersectClosest, rays, p);
   if (settings_.fused) {
     launch(Stage::kShade, rays, p);  // the queues it fills hold at most `rays` slots
-    launch(Stage::kTraceShadow, rays, p);
   } else {
     launch(Stage::kShadeSurface, rays, p);
     launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
-    launch(Stage::kTraceShadow, rays, p);
     launch(Stage::kSampleBsdf, rays, p);
     launch(Stage::kRouletteCompact, rays, p);
   }
-  const std::uint32_t next = read_counter(p.queue_out);
+  // The bounce's one read-back: the shadow queue's length and the next bounce's ray count. Shadow
+  // rays are traced last, over exactly their count: launched over `rays`, as the other stages
+  // are, the work-groups past the queue's end (most of them where few rays find a surface or few
+  // lights are visible) cost more than the rays did (README, "Shadow rays launched over their
+  // count"). trace_shadow reads nothing the stages before it change after sample_lights (the
+  // bounce for its random numbers travels with the ray).
+  std::array<dev::uint, WP_QUEUE_COUNT> counts{};
+  rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),
+                                counts.data());
+  launch(Stage::kTraceShadow, counts[WP_QUEUE_SHADOW], p);
+  const std::uint32_t next = counts[p.queue_out];
   std::swap(p.queue_in, p.queue_out);
   return next;
 }

@@ -88,7 +88,8 @@ StageJob SceneBench::stage_job(Stage stage, int b) {
     job.launch_items = job.items = wave_paths_;
   } else {
     job.params = c.params;
-    job.launch_items = c.rays;
+    // As run_bounce launches them: shadow rays over their count, the other stages over the rays.
+    job.launch_items = stage == Stage::kTraceShadow ? c.shadows : c.rays;
     job.items = stage <= Stage::kShadeSurface  ? c.rays
                 : stage == Stage::kTraceShadow ? c.shadows
                                                : c.surfaces;

@@ -5,7 +5,8 @@
 // The captured state: one wave (the first min(pixels, wave size) pixels, sample 0) run through
 // the renderer's own start_wave / run_bounce, snapshotted where bounce 0 (the camera rays) and
 // bounce 1 (the first BSDF-sampled rays) begin. A stage's input is that snapshot with the stages
-// before it in the bounce run on it, exactly as run_bounce launches them.
+// before it in the Stage enum run on it, launched as run_bounce launches them (run_bounce traces
+// shadow rays last, which only adds to the radiance no other stage reads).
 #pragma once
 
 #include <cstdint>
