@@ -326,8 +326,14 @@ void read_exr(const std::string& path, EnvironmentMap& env) {
     env.height = static_cast<int>(h);
     env.texels.assign(std::size_t(w) * std::size_t(h), glm::vec4(0.0f));
     const std::size_t xs = sizeof(glm::vec4), ys = xs * std::size_t(w);
-    char* base = reinterpret_cast<char*>(env.texels.data()) - dw.min.x * std::ptrdiff_t(xs) -
-                 dw.min.y * std::ptrdiff_t(ys);
+    // OpenEXR addresses pixel (x, y) of a slice at base + x * xs + y * ys, so the base lies the
+    // window's origin before the texels: for an origin far from (0, 0) outside any object, even
+    // below address 0. Computed on the integer address (unsigned, wrapping as defined), since
+    // pointer arithmetic that leaves the array is undefined (UBSan, a fuzz finding: a window at
+    // y = 690 million).
+    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(env.texels.data());
+    char* base = reinterpret_cast<char*>(first - std::uintptr_t(std::intptr_t(dw.min.x)) * xs -
+                                         std::uintptr_t(std::intptr_t(dw.min.y)) * ys);
     Imf::FrameBuffer fb;
     fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
     fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));

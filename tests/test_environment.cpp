@@ -133,10 +133,12 @@ TEST(EnvironmentLoad, HdrRoundTrip) {
 }
 
 // Writes an EXR of 32-bit float channels (R, G, B unless told) with a data window that does not
-// start at (0, 0).
+// start at (0, 0): at `origin`.
 void write_exr(const std::string& path, int w, int h, const std::function<float(int, int, int)>& f,
-               const std::vector<std::string>& channels = {"R", "G", "B"}) {
-  const Imath::Box2i display({0, 0}, {w - 1, h - 1}), data({-3, 5}, {w - 4, h + 4});
+               const std::vector<std::string>& channels = {"R", "G", "B"},
+               Imath::V2i origin = {-3, 5}) {
+  const Imath::Box2i display({0, 0}, {w - 1, h - 1}),
+      data(origin, {origin.x + w - 1, origin.y + h - 1});
   Imf::Header header(display, data);
   for (const auto& c : channels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
   std::vector<float> px(std::size_t(w) * std::size_t(h) * channels.size());
@@ -146,7 +148,11 @@ void write_exr(const std::string& path, int w, int h, const std::function<float(
         px[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * channels.size() + c] =
             f(x, y, int(c));
   const std::size_t xs = channels.size() * sizeof(float), ys = xs * std::size_t(w);
-  char* base = reinterpret_cast<char*>(px.data()) + 3 * std::ptrdiff_t(xs) - 5 * std::ptrdiff_t(ys);
+  // OpenEXR's slice base: the pixels less the origin's offset, on the integer address (the
+  // pointer itself may lie outside any object; see host/environment.cpp, read_exr).
+  char* base = reinterpret_cast<char*>(reinterpret_cast<std::uintptr_t>(px.data()) -
+                                       std::uintptr_t(std::intptr_t(origin.x)) * xs -
+                                       std::uintptr_t(std::intptr_t(origin.y)) * ys);
   Imf::FrameBuffer fb;
   for (std::size_t c = 0; c < channels.size(); ++c)
     fb.insert(channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
@@ -155,20 +161,29 @@ void write_exr(const std::string& path, int w, int h, const std::function<float(
   file.writePixels(h);
 }
 
+// The data window's origin anywhere, also a billion pixels from (0, 0) (OpenEXR's limit is about
+// 2^30). Its fuzz finding, that the loader's slice base for such a window was undefined pointer
+// arithmetic (UBSan), is a seed of tools/fuzz.sh (tests/fuzz/make_seeds.py,
+// builtin_far_origin.exr); without UBSan, the test below can only check that such a file is an
+// error, not a crash.
 TEST(EnvironmentLoad, ExrDataWindow) {
   const std::string path = temp_file("window.exr");
   const auto value = [](int x, int y, int c) {
     return float(x) + 10.0f * float(y) + 0.25f * float(c);
   };
-  write_exr(path, 6, 4, value);
-  const wp::EnvironmentMap env = wp::load_environment(path);
-  std::filesystem::remove(path);
-  ASSERT_EQ(env.width, 6);
-  ASSERT_EQ(env.height, 4);
-  for (int y = 0; y < 4; ++y)
-    for (int x = 0; x < 6; ++x)
-      for (int c = 0; c < 3; ++c)
-        EXPECT_EQ(env.texels[std::size_t(y * 6 + x)][c], value(x, y, c)) << x << " " << y;
+  for (const Imath::V2i& origin : {Imath::V2i(-3, 5), Imath::V2i(1000000000, 1000000000),
+                                   Imath::V2i(-1000000000, 500000000)}) {
+    write_exr(path, 6, 4, value, {"R", "G", "B"}, origin);
+    const wp::EnvironmentMap env = wp::load_environment(path);
+    std::filesystem::remove(path);
+    ASSERT_EQ(env.width, 6);
+    ASSERT_EQ(env.height, 4);
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 6; ++x)
+        for (int c = 0; c < 3; ++c)
+          EXPECT_EQ(env.texels[std::size_t(y * 6 + x)][c], value(x, y, c))
+              << x << " " << y << " origin " << origin.x << "," << origin.y;
+  }
 }
 
 // An EXR whose header declares a data window far larger than the file holds, in the form the
@@ -176,7 +191,8 @@ TEST(EnvironmentLoad, ExrDataWindow) {
 // dataWindow attribute (box2i xMin, yMin, xMax, yMax, little-endian int32) is then patched to a
 // wide x range; OpenEXR opens it, and the loader used to allocate width x 2 x 16 bytes (4 GiB
 // for 2^28 texels, 537 MB for 2^25) before reading failed. Refused now before any allocation.
-void write_wide_exr(const std::string& path, std::int32_t x_min, std::int32_t x_max) {
+void write_wide_exr(const std::string& path, std::int32_t x_min, std::int32_t x_max,
+                    std::int32_t y_min = 0, std::int32_t y_max = 1) {
   {
     Imf::Header header(6, 2);
     header.compression() = Imf::RLE_COMPRESSION;
@@ -199,8 +215,9 @@ void write_wide_exr(const std::string& path, std::int32_t x_min, std::int32_t x_
   f.clear();
   f.seekp(static_cast<std::streamoff>(box));
   f.write(reinterpret_cast<const char*>(&x_min), 4);
-  f.seekp(static_cast<std::streamoff>(box + 8));
+  f.write(reinterpret_cast<const char*>(&y_min), 4);
   f.write(reinterpret_cast<const char*>(&x_max), 4);
+  f.write(reinterpret_cast<const char*>(&y_max), 4);
 }
 
 TEST(EnvironmentLoad, ExrHugeDataWindowIsAnError) {
@@ -217,6 +234,25 @@ TEST(EnvironmentLoad, ExrHugeDataWindowIsAnError) {
     }
     std::filesystem::remove(path);
   }
+}
+
+// The fuzz finding of ExrDataWindow's comment in the form a test can write: a window 2 million
+// pixels wide (allowed for a file this size: the header may be honest about a file cut short) at
+// y = 10^9, over a file that holds 6 x 2 pixels. The loader allocates the row, sets OpenEXR's slice
+// base (before the fix, pointer arithmetic far outside the row) and reports OpenEXR's failure to
+// read it: one error, no crash.
+TEST(EnvironmentLoad, ExrFarWindowOverMissingPixelsIsAnError) {
+  const std::string path = temp_file("far_window.exr");
+  write_wide_exr(path, 0, 1999999, 1000000000, 1000000000);
+  try {
+    wp::load_environment(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const wp::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot read the EXR image"), std::string::npos)
+        << e.what();
+    std::cout << "  refused: " << e.what() << "\n";
+  }
+  std::filesystem::remove(path);
 }
 
 // An attribute stating more bytes than the file has (fuzzing: 1.6 GB in a 202-byte file, which

@@ -298,23 +298,27 @@ def crop_hdr(path, rows):
     return data[:end] + b"-Y %d +X %d\n" % (rows, width) + data[line_end + 1:at]
 
 
-def exr(width, height, value):
-    """An uncompressed scanline OpenEXR file of FLOAT R, G, B."""
+def exr(width, height, value, origin=(0, 0), pixels=True):
+    """An uncompressed scanline OpenEXR file of FLOAT R, G, B, its data window at `origin`; without
+    `pixels`, the header and line offset table alone (a file cut short)."""
     def attr(name, kind, payload):
         return name + b"\0" + kind + b"\0" + struct.pack("<i", len(payload)) + payload
     channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in (b"B", b"G", b"R"))
-    box = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    x0, y0 = origin
+    box = struct.pack("<4i", x0, y0, x0 + width - 1, y0 + height - 1)
     header = (struct.pack("<I4B", 20000630, 2, 0, 0, 0) + attr(b"channels", b"chlist", channels + b"\0")
               + attr(b"compression", b"compression", b"\0") + attr(b"dataWindow", b"box2i", box)
               + attr(b"displayWindow", b"box2i", box) + attr(b"lineOrder", b"lineOrder", b"\0")
               + attr(b"pixelAspectRatio", b"float", struct.pack("<f", 1))
               + attr(b"screenWindowCenter", b"v2f", struct.pack("<2f", 0, 0))
               + attr(b"screenWindowWidth", b"float", struct.pack("<f", 1)) + b"\0")
+    if not pixels:
+        return header + struct.pack("<Q", len(header) + 8 * height) * height
     line = b"".join(struct.pack("<%df" % width, *([v] * width)) for v in value[::-1])  # B, G, R
     block_size = 8 + len(line)
     first = len(header) + 8 * height
     table = b"".join(struct.pack("<Q", first + y * block_size) for y in range(height))
-    blocks = b"".join(struct.pack("<ii", y, len(line)) + line for y in range(height))
+    blocks = b"".join(struct.pack("<ii", y0 + y, len(line)) + line for y in range(height))
     return header + table + blocks
 
 
@@ -330,6 +334,10 @@ def main():
     builtin_hdr(env_dir)
     with open(os.path.join(env_dir, "builtin.exr"), "wb") as f:
         f.write(exr(3, 2, (0.5, 1.0, 2.0)))
+    # Fuzz finding: a data window far from (0, 0), here 2 million pixels wide at y = 10^9 in a cut
+    # short file (the loader's slice base pointer overflowed before OpenEXR found the data missing).
+    with open(os.path.join(env_dir, "builtin_far_origin.exr"), "wb") as f:
+        f.write(exr(2000000, 1, (0.5, 1.0, 2.0), origin=(0, 1000000000), pixels=False))
     # Fuzz finding: an attribute stating 1.6 GB in a small file (OpenEXR allocated it first).
     with open(os.path.join(env_dir, "builtin_long_attribute.exr"), "wb") as f:
         f.write(struct.pack("<I4B", 20000630, 2, 0, 0, 0) + b"junk\0opaqueType\0"
