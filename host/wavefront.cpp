@@ -153,6 +153,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
 // kernel_build_seconds reports it) instead of the first sample pass.
 void Wavefront::prime_kernels() {
   dev::Launch p = launch_params(0, 0, 0);  // no paths: every work-item returns at once
+  p.wave_pixels = 1;  // never divided by here (nothing gets past its early return), but not by 0
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
   try {
