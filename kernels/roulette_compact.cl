@@ -8,9 +8,9 @@
 #include "stage.h"
 #include "surface.h"
 
-/* Roulette for the path in `slot`: true for a survivor, which the caller pushes to queue_out.
- * Shared by this stage and the fused shade.cl. */
-WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot) {
+/* Roulette for the path in `slot` with u, its WP_DIM_ROULETTE number: true for a survivor, which
+ * the caller pushes to queue_out. Shared by this stage and the fused shade.cl. */
+WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot, float u) {
   const float4 beta = paths.throughput[slot];
   if (!all(isfinite(beta))) { /* sample_bsdf catches these first; a NaN is never dropped silently */
     count_nonfinite(queues);
@@ -23,7 +23,7 @@ WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot) 
   const float m = max3(beta.xyz) * paths.radiance[slot].w;
   const uint bounce = paths.info[slot].y;
   if (bounce + 1u >= launch.rr_depth && m < 1.0f) {
-    if (rng_get(path_rng(paths, slot, launch), WP_DIM_ROULETTE) >= m) return false;
+    if (u >= m) return false;
     paths.throughput[slot] = (float4)(beta.xyz / m, beta.w);
   }
   paths.info[slot].y = bounce + 1u;
@@ -36,6 +36,7 @@ WP_GROUP_KERNEL void roulette_compact(WP_STAGE_PARAMS) {
   uint slot = 0u;
   bool survives = false;
   if (queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot))
-    survives = roulette(paths, queues, launch, slot);
+    survives = roulette(paths, queues, launch, slot,
+                        rng_get(path_rng(paths, slot, launch), WP_DIM_ROULETTE));
   queue_push_group(queues, launch.queue_out, survives, slot, scan);
 }

@@ -10,13 +10,11 @@
 #include "stage.h"
 #include "surface.h"
 
-/* The next ray of the path in `slot` from surface s. Shared by this stage and the fused shade.cl.
- */
-WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, Launch launch, uint slot,
-                                 const Surface* s) {
-  const Rng rng = path_rng(paths, slot, launch);
-  const BsdfSample bs = bsdf_sample(s, -paths.ray_d[slot].xyz, rng_get(rng, WP_DIM_BSDF_LOBE),
-                                    rng_get2(rng, WP_DIM_BSDF_U));
+/* The next ray of the path in `slot` from surface s with the bounce's random numbers u (its lobe
+ * choice and direction). Shared by this stage and the fused shade.cl. */
+WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Surface* s,
+                                 const BounceRandom* u) {
+  const BsdfSample bs = bsdf_sample(s, -paths.ray_d[slot].xyz, u->lobe, u->bsdf_uv);
   const float4 beta = paths.throughput[slot];
   const float3 next = beta.xyz * bs.weight;
   const bool finite = all(isfinite(next)) && isfinite(bs.pdf);
@@ -52,5 +50,7 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   uint slot;
   if (!queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) return;
   const Surface s = surface_load(paths, slot);
-  sample_next_ray(paths, queues, launch, slot, &s);
+  BounceRandom u;
+  bounce_random(path_rng(paths, slot, launch), &u);
+  sample_next_ray(paths, queues, slot, &s, &u);
 }

@@ -9,14 +9,13 @@
 #include "surface.h"
 
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-/* NEE at surface s of the path in `slot`: a shadow ray for WP_QUEUE_SHADOW, true when there is one
- * (the caller pushes it). Shared by this stage and the fused shade.cl. */
-WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues queues, Launch launch,
-                                  uint slot, const Surface* s) {
+/* NEE at surface s of the path in `slot` with the bounce's random numbers u (its light pick and
+ * light point): a shadow ray for WP_QUEUE_SHADOW, true when there is one (the caller pushes it).
+ * Shared by this stage and the fused shade.cl. */
+WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues queues, uint slot,
+                                  const Surface* s, const BounceRandom* u) {
   if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return false;
-  const Rng rng = path_rng(paths, slot, launch);
-  const LightSample ls =
-      sample_light(scene, s->p, rng_get(rng, WP_DIM_LIGHT_PICK), rng_get2(rng, WP_DIM_LIGHT_U));
+  const LightSample ls = sample_light(scene, s->p, u->light_pick, u->light_uv);
   if (!(ls.pdf > 0.0f)) return false;
   const BsdfEval e = bsdf_eval(s, -paths.ray_d[slot].xyz, ls.wi);
   const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
@@ -55,7 +54,9 @@ WP_GROUP_KERNEL void sample_lights(WP_STAGE_PARAMS) {
   bool shadow = false;
   if (queue_get(queues, WP_QUEUE_SURFACE, get_global_id(0), &slot)) {
     const Surface s = surface_load(paths, slot);
-    shadow = sample_light_ray(&scene, paths, queues, launch, slot, &s);
+    BounceRandom u;
+    bounce_random(path_rng(paths, slot, launch), &u);
+    shadow = sample_light_ray(&scene, paths, queues, slot, &s, &u);
   }
   queue_push_group(queues, WP_QUEUE_SHADOW, shadow, slot, scan);
 #endif

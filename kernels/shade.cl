@@ -6,9 +6,8 @@
  * To:   queue_out (next rays) and WP_QUEUE_SHADOW, which trace_shadow then traces.
  * It calls the same functions as those four stages, in the same order per path, with the same
  * random numbers, so the image is the split pipeline's bit for bit (RenderSettings::fused; tested
- * by RenderKnown.FusedAndSplitShadingAreBitIdentical). Not the default: on PoCL it measured no
- * faster than the split stages (README, "Fused shading"); it is there for devices where keeping
- * the surface in registers pays (GPUs: to be measured). */
+ * by RenderKnown.FusedAndSplitShadingAreBitIdentical). The default pipeline (README, "Fused
+ * shading"). */
 #include "stage.h"
 #include "surface.h"
 
@@ -17,14 +16,21 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
   WP_GROUP_SCRATCH(scan);
   uint slot = 0u;
   bool shadow = false, survives = false;
-  Surface s;
-  if (queue_get(queues, launch.queue_in, get_global_id(0), &slot) &&
-      shade_hit(&scene, paths, launch, slot, &s)) {
+  if (queue_get(queues, launch.queue_in, get_global_id(0), &slot)) {
+    /* The bounce's random numbers first, before the hit is resolved: their integer chains (about
+     * 100 cycles deep) then run beside shade_hit's loads instead of holding up the light sample
+     * that needs them (README, "Random numbers drawn first"). Paths that end at this hit draw them
+     * for nothing, which costs less. */
+    BounceRandom u;
+    bounce_random(path_rng(paths, slot, launch), &u);
+    Surface s;
+    if (shade_hit(&scene, paths, launch, slot, &s)) {
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-    shadow = sample_light_ray(&scene, paths, queues, launch, slot, &s);
+      shadow = sample_light_ray(&scene, paths, queues, slot, &s, &u);
 #endif
-    sample_next_ray(paths, queues, launch, slot, &s);
-    survives = roulette(paths, queues, launch, slot);
+      sample_next_ray(paths, queues, slot, &s, &u);
+      survives = roulette(paths, queues, launch, slot, u.roulette);
+    }
   }
 #if WP_STRATEGY != WP_STRATEGY_BSDF
   queue_push_group(queues, WP_QUEUE_SHADOW, shadow, slot, scan);

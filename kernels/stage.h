@@ -36,4 +36,23 @@ static inline Rng path_rng(Paths paths, uint slot, Launch launch) {
   return path_rng_at(paths, slot, launch, paths.info[slot].y);
 }
 
+/* The random numbers one scattering event draws (rng.h's per-bounce dimensions), all at once
+ * (rng_bounce): the fused kernel draws them before it needs any, as independent chains the CPU
+ * overlaps; drawn at their point of use, each one's latency held up the work that needed it. */
+typedef struct BounceRandom {
+  float light_pick, lobe, roulette;
+  float2 light_uv, bsdf_uv;
+} BounceRandom;
+
+/* Written through a pointer rather than returned: an always-inlined function returning a struct
+ * leaves llvm.experimental.noalias.scope.decl behind, which Oclgrind cannot run. */
+static inline __attribute__((always_inline)) void bounce_random(Rng r, BounceRandom* u) {
+  const float8 v = rng_bounce(r);
+  u->light_pick = v.s0;
+  u->light_uv = (float2)(v.s1, v.s5);
+  u->lobe = v.s2;
+  u->bsdf_uv = (float2)(v.s3, v.s6);
+  u->roulette = v.s4;
+}
+
 #endif /* WP_STAGE_H */

@@ -63,6 +63,17 @@ class Patterns {
     return h_.read<cl_float2>(out, n);
   }
 
+  // rng_bounce at each coordinate (the group unused): eight numbers per coordinate.
+  std::vector<float> draw_bounce(const std::vector<Coord>& coords) {
+    std::vector<wp::dev::uint4> in;
+    in.reserve(coords.size());
+    for (const Coord& c : coords) in.push_back({c.pixel, c.sample, c.bounce, 0u});
+    const auto n = static_cast<std::uint32_t>(in.size());
+    cl::Buffer out = h_.buffer<cl_float>(std::size_t{8} * n);
+    h_.run("draw_bounce", n, h_.buffer(in), kSeed, n, out);
+    return h_.read<cl_float>(out, std::size_t{8} * n);
+  }
+
  private:
   explicit Patterns(int sampler)
       : h_({"rng_kernels.cl"}, "-D WP_SAMPLER=" + std::to_string(sampler)) {}
@@ -189,6 +200,38 @@ TEST(Rng, GroupsBouncesAndPixelsAreIndependent) {
         EXPECT_GT(r.p_value, kMinP)
             << pattern_name(sampler) << " " << c.name << " pixel " << p << ": " << r.detail;
       }
+}
+
+// rng_bounce, which draws a bounce's numbers eight at a time for the shading kernels, gives each
+// exactly what rng_get / rng_get2 give for its group (lanes as rng.h's WP_BOUNCE_GROUPS), bit for
+// bit, over pixels, samples and bounces up to the 32-bit extremes.
+TEST(Rng, BounceDrawEqualsTheOneByOneDraws) {
+  // lane -> (group in kGroups, which number of the group)
+  const std::pair<int, int> lanes[8] = {{1, 0}, {2, 0}, {3, 0}, {4, 0},
+                                        {5, 0}, {2, 1}, {4, 1}, {4, 1}};
+  std::vector<Coord> points;
+  std::uint32_t h = 1;
+  for (std::uint32_t i = 0; i < 4096; ++i) {
+    h = h * 1664525u + 1013904223u;  // any spread of coordinates will do
+    const std::uint32_t pixel = i < 8 ? 0xffffffffu - i : h >> (i % 13);
+    const std::uint32_t sample = i % 3 == 0 ? i : h ^ (h >> 7);
+    points.push_back({pixel, sample, i % 14, kGroups[0]});
+  }
+  for (int sampler : {0, 1}) {
+    Patterns& patterns = Patterns::get(sampler);
+    const std::vector<float> all = patterns.draw_bounce(points);
+    for (int lane = 0; lane < 8; ++lane) {
+      std::vector<Coord> coords = points;
+      for (Coord& c : coords) c.group = kGroups[lanes[lane].first];
+      const auto one = patterns.draw(coords);
+      int differ = 0;
+      for (std::size_t i = 0; i < points.size(); ++i)
+        differ += all[8 * i + static_cast<std::size_t>(lane)] !=
+                  one[i].s[static_cast<std::size_t>(lanes[lane].second)];
+      EXPECT_EQ(differ, 0) << pattern_name(sampler) << " lane " << lane << " ("
+                           << kGroups[lanes[lane].first].name << ")";
+    }
+  }
 }
 
 // Known answer: f(u, v) = (1 + cos(2 pi u)) (1 + v^2) has the integral 1 * 4/3 over [0,1)^2.

@@ -3,7 +3,8 @@
  * with -D WP_SAMPLER=0 or 1.
  *
  * coords[i] = (pixel, sample, bounce, dim | pair << 16); out[i] = rng_get2(r, dim) when pair is 1,
- * else (rng_get(r, dim), 0). */
+ * else (rng_get(r, dim), 0). draw_bounce: out[i] = rng_bounce(r), all of a bounce's numbers at
+ * once (the dim of coords[i] unused). */
 #include "rng.h"
 
 __kernel void draw_rng(__global const uint4* coords, uint seed, uint count, __global float2* out) {
@@ -13,4 +14,12 @@ __kernel void draw_rng(__global const uint4* coords, uint seed, uint count, __gl
   const Rng r = rng_make(c.x, c.y, seed, c.z);
   const uint dim = c.w & 0xffffu;
   out[i] = (c.w >> 16) != 0u ? rng_get2(r, dim) : (float2)(rng_get(r, dim), 0.0f);
+}
+
+__kernel void draw_bounce(__global const uint4* coords, uint seed, uint count,
+                          __global float8* out) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  const uint4 c = coords[i];
+  out[i] = rng_bounce(rng_make(c.x, c.y, seed, c.z));
 }
