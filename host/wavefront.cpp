@@ -17,9 +17,10 @@ namespace {
 // The one place where program build options are assembled: the scene's features and the
 // settings that are compile-time constants of the kernels.
 std::string program_options(const SceneFeatures& features, const RenderSettings& s, int bvh_width,
-                            std::size_t group_size) {
+                            std::size_t group_size, bool prefetch) {
   std::string o = "-cl-std=CL1.2 -D WP_BVH_WIDTH=" + std::to_string(bvh_width);
   o += " -D WP_GROUP_SIZE=" + std::to_string(group_size);
+  if (prefetch) o += " -D WP_PREFETCH=1";
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
   o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
@@ -69,7 +70,13 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   const EnvironmentMap* env = settings.environment.get();
   features_ =
       settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
-  options_ = program_options(features_, settings, bvh.width, local_size_);
+  // Cache hints in the stages that read path state through a queue (kernels/features.h,
+  // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
+  // instruction and every address space is one.
+  const DeviceEntry& device = rt_.device();
+  const bool prefetch =
+      settings.prefetch && !device.gpu && device.platform_name == "Portable Computing Language";
+  options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
   path_state_ = path_state_layout(wave_paths(), settings.aov);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);

@@ -65,6 +65,9 @@ struct RenderSettings {
   // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit.
   // Fused by default: on PoCL it measured 10% faster on the Cornell box (README, "Fused shading").
   bool fused = true;
+  // Cache hints for the path state ahead in each queue, on PoCL's CPU devices (kernels/features.h,
+  // WP_PREFETCH); elsewhere nothing. The same image either way.
+  bool prefetch = true;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Most bytes in one scene buffer (device_scene.h); 0: the device's largest allocation. Smaller
   // values split even small scenes over several buffers (tests).

@@ -68,6 +68,16 @@
 #define WP_GROUP_SIZE 64
 #endif
 
+/* Prefetching: 1 (the host sets it on PoCL's CPU devices) lets the stages that read path state
+ * through a queue hint the cache at the slot WP_PREFETCH_AHEAD entries further along (stage.h,
+ * prefetch_slot). The slots of a queue are scattered over a path state of tens of megabytes, and
+ * a CPU runs a work-group's work-items one after the other, so without the hint each one starts by
+ * waiting for its own cache misses. */
+#ifndef WP_PREFETCH
+#define WP_PREFETCH 0
+#endif
+#define WP_PREFETCH_AHEAD 32u
+
 /* AOVs: 1 records each sample's albedo, normal and depth (path_state.def, shade_surface.cl)
  * and adds them to the film (shared/film.h); 0 (the default) compiles none of it. */
 #ifndef WP_AOV

@@ -7,7 +7,12 @@
 
 __kernel void intersect_closest(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
-  uint slot;
+  uint slot, ahead;
+  if (prefetch_slot(queues, launch.queue_in, get_global_id(0), &ahead)) {
+    wp_prefetch(paths.ray_o + ahead);
+    wp_prefetch(paths.ray_d + ahead);
+    wp_prefetch(paths.hit + ahead);
+  }
   if (!queue_get(queues, launch.queue_in, get_global_id(0), &slot)) return;
   const float4 o = paths.ray_o[slot], d = paths.ray_d[slot];
   const uint key = rng_bits(path_rng(paths, slot, launch), WP_DIM_ALPHA_CLOSEST);

@@ -16,6 +16,15 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
   WP_GROUP_SCRATCH(scan);
   uint slot = 0u;
   bool shadow = false, survives = false;
+  uint ahead;
+  if (prefetch_slot(queues, launch.queue_in, get_global_id(0), &ahead)) {
+    wp_prefetch(paths.info + ahead);
+    wp_prefetch(paths.hit + ahead);
+    wp_prefetch(paths.ray_d + ahead);
+    wp_prefetch(paths.throughput + ahead);
+    wp_prefetch(paths.radiance + ahead);
+    wp_prefetch(paths.ray_o + ahead);
+  }
   if (queue_get(queues, launch.queue_in, get_global_id(0), &slot)) {
     /* The bounce's random numbers first, before the hit is resolved: their integer chains (about
      * 100 cycles deep) then run beside shade_hit's loads instead of holding up the light sample

@@ -20,6 +20,20 @@
   const Paths paths = paths_bind(path_buf, path_layout); \
   const Queues queues = queues_bind(queue_slots, queue_counters, path_layout.capacity)
 
+/* Hints the cache at `p` (WP_PREFETCH; a no-op elsewhere). Through an integer: a CPU device's
+ * address spaces are all one. */
+#if WP_PREFETCH
+#define wp_prefetch(p) __builtin_prefetch((const void*)(size_t)(p), 0, 3)
+#else
+#define wp_prefetch(p) ((void)(p))
+#endif
+
+/* The slot WP_PREFETCH_AHEAD entries after `index` in queue q, for prefetching; false past the
+ * queue's end, or without WP_PREFETCH. */
+static inline bool prefetch_slot(Queues queues, uint q, uint index, uint* slot) {
+  return WP_PREFETCH && queue_get(queues, q, index + WP_PREFETCH_AHEAD, slot);
+}
+
 /* The sample index of the path in `slot`: a wave holds one or more samples of its pixels, one after
  * another (Launch.wave_pixels). */
 static inline uint path_sample(Launch launch, uint slot) {

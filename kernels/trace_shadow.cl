@@ -19,7 +19,13 @@
 
 __kernel void trace_shadow(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
-  uint slot;
+  uint slot, ahead;
+  if (prefetch_slot(queues, WP_QUEUE_SHADOW, get_global_id(0), &ahead)) {
+    wp_prefetch(paths.shadow_o + ahead);
+    wp_prefetch(paths.shadow_d + ahead);
+    wp_prefetch(paths.shadow_l + ahead);
+    wp_prefetch(paths.radiance + ahead);
+  }
   if (!queue_get(queues, WP_QUEUE_SHADOW, get_global_id(0), &slot)) return;
   const float4 o = paths.shadow_o[slot];
   const float4 dw = paths.shadow_d[slot];

@@ -16,6 +16,8 @@
 #include <cstring>
 #include <functional>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -414,17 +416,28 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
     double sum = 0.0;
     for (float v : reference) sum += v;
     EXPECT_GT(sum, 0.0);
-    for (const auto& [wave, local] : std::vector<std::pair<std::size_t, std::size_t>>{
-             {0, 0}, {1000, 0}, {777, 8}, {0, 64}, {256, 32}, {333, 1}, {0, 256}}) {
+    // ... and with the cache hints off (prefetch false; on PoCL they are on by default).
+    for (const auto& [wave, local, prefetch] :
+         std::vector<std::tuple<std::size_t, std::size_t, bool>>{{0, 0, true},
+                                                                 {1000, 0, true},
+                                                                 {777, 8, true},
+                                                                 {0, 64, true},
+                                                                 {256, 32, true},
+                                                                 {333, 1, true},
+                                                                 {0, 256, true},
+                                                                 {0, 0, false},
+                                                                 {333, 1, false}}) {
       st.wave_size = wave;
       st.local_size = local;
+      st.prefetch = prefetch;
       const auto image = wp::render(*runtime_, s, st).image.rgb;
       ASSERT_EQ(image.size(), reference.size());
       EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))
-          << "wave " << wave << " local " << local;
+          << "wave " << wave << " local " << local << " prefetch " << prefetch;
     }
     st.wave_size = 0;
     st.local_size = 0;
+    st.prefetch = true;
     st.seed = 12;
     const auto other = wp::render(*runtime_, s, st).image.rgb;
     EXPECT_NE(0, std::memcmp(other.data(), reference.data(), other.size() * sizeof(float)));
