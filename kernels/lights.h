@@ -2,7 +2,8 @@
  * sampling found.
  *
  * Level 1: one light per shading point from the alias table (host/light_table.h documents the
- * uniform and power-proportional probabilities). Then, per light:
+ * uniform and power-proportional probabilities); with few lights the pick reuses the first
+ * coordinate of the point's 2D number (sample_light). Then, per light:
  * - punctual (KHR_lights_punctual), delta distributions: a point/spot intensity is radiant
  *   intensity in W/sr, giving irradiance I / d^2 (spot: times the recommended cone falloff); a
  *   directional light's intensity is irradiance in W/m^2;
@@ -32,12 +33,18 @@ typedef struct LightSample {
                     area light's surface toward the shading point so the ray cannot hit it */
 } LightSample;
 
-static inline uint pick_light(const SceneView* scene, float u, float* pmf) {
+/* The light that u in (0, 1) picks from the alias table, its probability in *pmf, and in *rest
+ * what is left of u within the pick: uniform in [0, 1) for each light picked, so it can serve as
+ * a coordinate of the point on it (sample_light). */
+static inline uint pick_light(const SceneView* scene, float u, float* pmf, float* rest) {
   const uint n = scene->desc->light_count;
   const float x = u * (float)n;
   const uint i = min((uint)x, n - 1u);
   const LightAlias e = scene->light_alias[i];
-  const uint chosen = (x - (float)i) < e.prob ? i : e.alias;
+  const float f = x - (float)i;
+  const bool own = f < e.prob;
+  const uint chosen = own ? i : e.alias;
+  *rest = fmin(own ? f / e.prob : (f - e.prob) / (1.0f - e.prob), 0x1.fffffep-1f);
   *pmf = scene->light_alias[chosen].pmf;
   return chosen;
 }
@@ -113,10 +120,20 @@ static inline LightSample sample_triangle(const SceneView* scene, uint tri, floa
   return s;
 }
 
+/* With at most this many lights, one 2D number both picks the light (its first coordinate) and
+ * places the point on it (what is left of that coordinate, and the second), as Mitsuba does: the
+ * points of a pixel's samples then stay one stratified set over all the lights together (a quad
+ * light of two triangles is sampled as well as one shape). Past it, the pick takes its own
+ * number, so that the first coordinate keeps its bits (what is left of it has 23 - log2(lights)).
+ */
+#define WP_LIGHT_PICK_REUSE_MAX 64u
+
 /* One light sample for the shading point p. */
 static inline LightSample sample_light(const SceneView* scene, float3 p, float u_pick, float2 u) {
-  float pmf;
-  const uint i = pick_light(scene, u_pick, &pmf);
+  float pmf, rest;
+  const bool reuse = scene->desc->light_count <= WP_LIGHT_PICK_REUSE_MAX;
+  const uint i = pick_light(scene, reuse ? u.x : u_pick, &pmf, &rest);
+  if (reuse) u.x = rest;
   __global const Light* light = scene->lights + i;
   LightSample s;
   const uint type = light->meta.x;

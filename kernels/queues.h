@@ -60,11 +60,37 @@ static inline void queue_push_group(Queues qs, uint q, bool push, uint slot, __l
   if (push) qs.slots[q * qs.capacity + scan[WP_GROUP_SIZE] + scan[lid]] = slot;
 }
 
+/* Two queue_push_group calls in one: slot goes to queue qa where push_a holds and to queue qb where
+ * push_b holds, with one scan of both flags packed in a word (a group's ranks fit in 16 bits), so
+ * half the barriers and scans of two calls. Each queue's entries come out in the order two calls
+ * would give them. */
+static inline void queue_push_group2(Queues qs, uint qa, bool push_a, uint qb, bool push_b,
+                                     uint slot, __local uint* scan) {
+  const uint lid = get_local_id(0);
+  scan[lid] = (push_a ? 1u : 0u) | (push_b ? 0x10000u : 0u);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (lid == 0u) {
+    uint total = 0u;
+    for (uint i = 0u; i < WP_GROUP_SIZE; ++i) {
+      const uint flag = scan[i];
+      scan[i] = total;
+      total += flag;
+    }
+    const uint ta = total & 0xffffu, tb = total >> 16;
+    scan[WP_GROUP_SIZE] = ta ? atomic_add(&qs.counters[qa], ta) : 0u;
+    scan[WP_GROUP_SIZE + 1u] = tb ? atomic_add(&qs.counters[qb], tb) : 0u;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  const uint rank = scan[lid];
+  if (push_a) qs.slots[qa * qs.capacity + scan[WP_GROUP_SIZE] + (rank & 0xffffu)] = slot;
+  if (push_b) qs.slots[qb * qs.capacity + scan[WP_GROUP_SIZE + 1u] + (rank >> 16)] = slot;
+}
+
 /* A stage kernel that pushes to queues: launched with exactly WP_GROUP_SIZE work-items per group,
  * which its local scan (WP_GROUP_SCRATCH) is sized for. */
 #define WP_GROUP_KERNEL __kernel __attribute__((reqd_work_group_size(WP_GROUP_SIZE, 1, 1)))
 /* The local memory of queue_push_group, declared at the top of such a kernel. */
-#define WP_GROUP_SCRATCH(name) __local uint name[WP_GROUP_SIZE + 1]
+#define WP_GROUP_SCRATCH(name) __local uint name[WP_GROUP_SIZE + 2]
 
 /* Counts a NaN or infinite value that a stage drops (it must never happen; the renderer reports
  * the count and the tests require 0). Every place that drops such a value counts it, so that no

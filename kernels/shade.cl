@@ -42,7 +42,8 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
     }
   }
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-  queue_push_group(queues, WP_QUEUE_SHADOW, shadow, slot, scan);
-#endif
+  queue_push_group2(queues, WP_QUEUE_SHADOW, shadow, launch.queue_out, survives, slot, scan);
+#else
   queue_push_group(queues, launch.queue_out, survives, slot, scan);
+#endif
 }

@@ -460,7 +460,9 @@ TEST(Sampling, TriangleLight) {
 
 // Light picking from an alias table over uneven weights (zeros included): frequencies against
 // the pmf by chi-square, zero-weight lights never picked, and each pick's reported pmf equal to
-// weight / total.
+// weight / total. What is left of the number within the pick (which places the point on the light
+// when the scene has few lights, lights.h) must be uniform on [0, 1) for each light: a
+// chi-square of (light, 16 bins of it) against pmf / 16 per cell.
 TEST(Sampling, LightPick) {
   std::vector<double> many(1000);
   for (std::size_t i = 0; i < many.size(); ++i)  // log-uniform over 4 decades, every 7th zero
@@ -471,27 +473,37 @@ TEST(Sampling, LightPick) {
   auto& h = Device::get(false).harness();
   cl::Buffer chosen = h.buffer<std::uint32_t>(std::size_t{kSamples});
   cl::Buffer pmfs = h.buffer<float>(std::size_t{kSamples});
+  cl::Buffer rests = h.buffer<float>(std::size_t{kSamples});
+  constexpr std::size_t kRestBins = 16;
   for (std::size_t t = 0; t < tables.size(); ++t) {
     SCOPED_TRACE("table " + std::to_string(t));
     const std::vector<double>& w = tables[t];
     const double total = std::accumulate(w.begin(), w.end(), 0.0);
     const auto alias = wp::build_alias_table(w);
     h.run("pick_lights", kSamples, static_cast<std::uint32_t>(w.size()), h.buffer(alias),
-          seed_of("pick" + std::to_string(t)), kSamples, chosen, pmfs);
+          seed_of("pick" + std::to_string(t)), kSamples, chosen, pmfs, rests);
     const auto idx = h.read<std::uint32_t>(chosen, kSamples);
     const auto pmf = h.read<float>(pmfs, kSamples);
+    const auto rest = h.read<float>(rests, kSamples);
     std::vector<double> observed(w.size(), 0.0), expected(w.size());
+    std::vector<double> joint(w.size() * kRestBins, 0.0), joint_expected(joint.size());
     double pmf_error = 0.0;
     for (std::size_t i = 0; i < kSamples; ++i) {
       ASSERT_LT(idx[i], w.size());
+      ASSERT_TRUE(rest[i] >= 0.0f && rest[i] < 1.0f) << "rest " << rest[i];
       observed[idx[i]] += 1.0;
+      joint[idx[i] * kRestBins + static_cast<std::size_t>(rest[i] * kRestBins)] += 1.0;
       const double p = w[idx[i]] / total;  // 0: caught below as observed_outside
       if (p > 0.0) pmf_error = std::max(pmf_error, std::fabs(pmf[i] - p) / p);
     }
     for (std::size_t i = 0; i < w.size(); ++i) {
       expected[i] = kSamples * w[i] / total;
+      for (std::size_t b = 0; b < kRestBins; ++b)
+        joint_expected[i * kRestBins + b] = expected[i] / kRestBins;
       EXPECT_NEAR(alias[i].pmf, w[i] / total, 1e-6 * w[i] / total) << "light " << i;
     }
+    const auto rj = wp::test::chi2_test(joint, joint_expected);
+    EXPECT_GT(rj.p_value, 1e-4) << "rest within the pick: " << rj.detail;
     const auto r = wp::test::chi2_test(observed, expected);
     EXPECT_EQ(r.observed_outside, 0.0) << "a zero-weight light was picked";
     if (w.size() > 1) {

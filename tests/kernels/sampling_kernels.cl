@@ -274,15 +274,19 @@ __kernel void lobe_selection(WP_CONFIG_PARAMS, __global float* out) {
   out[0] = l.spec, out[1] = l.trans, out[2] = l.diff;
 }
 
-/* From: an alias table of `light_count` entries. To: `count` picks (index, reported pmf). */
+/* From: an alias table of `light_count` entries. To: `count` picks (index, reported pmf, what is
+ * left of the number within the pick). */
 __kernel void pick_lights(uint light_count, __global const LightAlias* light_alias, uint seed,
-                          uint count, __global uint* chosen, __global float* pmfs) {
+                          uint count, __global uint* chosen, __global float* pmfs,
+                          __global float* rests) {
   const uint i = get_global_id(0);
   if (i >= count) return;
   SceneDesc desc;
   desc.light_count = light_count;
   const SceneView scene = test_scene(0, 0, 0, 0, light_alias, &desc);
-  float pmf;
-  chosen[i] = pick_light(&scene, rng_get(rng_make(i, 0u, seed, 0u), WP_DIM_LIGHT_PICK), &pmf);
+  float pmf, rest;
+  chosen[i] =
+      pick_light(&scene, rng_get(rng_make(i, 0u, seed, 0u), WP_DIM_LIGHT_PICK), &pmf, &rest);
   pmfs[i] = pmf;
+  rests[i] = rest;
 }
