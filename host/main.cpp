@@ -652,7 +652,7 @@ int main(int argc, char** argv) {
   render->add_option("--local-size", settings.local_size, "Work-group size [default: 64]");
   render->add_flag("--no-prefetch", cli.no_prefetch,
                    "No cache hints for the path state (on by default on PoCL's CPU devices, "
-                   "where they made renders 5-10% faster; the same image either way)");
+                   "where they made renders 3-8% faster; the same image either way)");
   render->add_option("--scene-buffer-kib", cli.scene_buffer_kib,
                      "Most KiB per scene buffer; the scene is split over up to 8 [default: the "
                      "device's largest allocation, see `wavepath devices`]");
