@@ -59,9 +59,13 @@ wavepath too: all three render the same purely Lambertian scene.
              sampler (renderer `mitsuba`, Mitsuba's default) or `ldsampler` (renderer
              `mitsuba-ld`: scrambled (0,2)-sequences, like wavepath's default Sobol' points;
              sample counts must be powers of 2), `path` integrator with max_depth = --max-depth + 1 and rr_depth =
-             --rr-depth + 1 (Mitsuba counts path segments from the camera, so max_depth 1 sees
+             --rr-depth (Mitsuba counts path segments from the camera, so max_depth 1 sees
              emitters only and 2 adds direct light; wavepath counts scattering events, so
-             wavepath's depth d is Mitsuba's d + 1).
+             wavepath's depth d is Mitsuba's d + 1; but Mitsuba's roulette, like wavepath's,
+             decides on the ray leaving the rr_depth-th scattering event: its path.cpp counts
+             the event before the test `depth >= rr_depth`, and its docs say rr_depth 1 may end
+             a path after the directly visible surface. Until 2026-11-25 this mapped rr_depth + 1,
+             which gave Mitsuba one more bounce before roulette than wavepath).
   Cycles     Mesh objects with a material Diffuse BSDF (roughness 0: Lambert) + Emission
              (colour = the radiance, strength 1), and, for a material that is not double-sided,
              a Mix Shader that turns back faces into a Transparent BSDF: wavepath culls back
@@ -180,7 +184,7 @@ def worker_mitsuba(job, scene):
     target = [cam["position"][i] + cam["forward"][i] for i in range(3)]
     d = {"type": "scene",
          "integrator": {"type": "path", "max_depth": job["max_depth"] + 1,
-                        "rr_depth": job["rr_depth"] + 1},
+                        "rr_depth": job["rr_depth"]},
          "sensor": {"type": "perspective", "fov_axis": "y", "fov": math.degrees(cam["yfov"]),
                     "near_clip": 1e-3, "far_clip": 1e4,
                     "to_world": mi.ScalarTransform4f().look_at(origin=cam["position"],
