@@ -33,43 +33,16 @@ static inline bool queue_get(Queues qs, uint q, uint index, uint* slot) {
   return true;
 }
 
-/* Appends `slot` to queue `q` where `push` holds, for the whole work-group at once: a scan of the
- * group's flags in local memory, one atomic add on the queue's counter per group, and each pushing
- * work-item writes its entry at the group's base plus its rank. One atomic per work-item instead
- * cost half the time of shade_surface and roulette_compact on PoCL (a locked add on a counter the
- * other cores share, which also waits for the work-item's earlier stores to drain).
- *
- * It holds barriers: every work-item of the group must call it, in the same order as the others,
- * none having returned before. `scan` is the kernel's WP_GROUP_SCRATCH (WP_GROUP_SIZE + 1 words).
- * The rank is the work-item's order in its group, so a queue's order still depends on which group
- * reached the counter first (nothing may depend on it; see the top of this file). */
-static inline void queue_push_group(Queues qs, uint q, bool push, uint slot, __local uint* scan) {
-  const uint lid = get_local_id(0);
-  scan[lid] = push ? 1u : 0u;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (lid == 0u) { /* serial, by one work-item: a CPU runs the group as one loop anyway */
-    uint total = 0u;
-    for (uint i = 0u; i < WP_GROUP_SIZE; ++i) {
-      const uint flag = scan[i];
-      scan[i] = total;
-      total += flag;
-    }
-    scan[WP_GROUP_SIZE] = total ? atomic_add(&qs.counters[q], total) : 0u;
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (push) qs.slots[q * qs.capacity + scan[WP_GROUP_SIZE] + scan[lid]] = slot;
-}
-
-/* Two queue_push_group calls in one: slot goes to queue qa where push_a holds and to queue qb where
- * push_b holds, with one scan of both flags packed in a word (a group's ranks fit in 16 bits), so
- * half the barriers and scans of two calls. Each queue's entries come out in the order two calls
- * would give them. */
+/* Two queue_push_group calls (below) in one: slot goes to queue qa where push_a holds and to queue
+ * qb where push_b holds, with one scan of both flags packed in a word (a group's ranks fit in 16
+ * bits: WP_GROUP_SIZE <= 1024), so half the barriers and scans of two calls. Each queue's entries
+ * come out in the order two calls would give them. */
 static inline void queue_push_group2(Queues qs, uint qa, bool push_a, uint qb, bool push_b,
                                      uint slot, __local uint* scan) {
   const uint lid = get_local_id(0);
   scan[lid] = (push_a ? 1u : 0u) | (push_b ? 0x10000u : 0u);
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (lid == 0u) {
+  if (lid == 0u) { /* serial, by one work-item: a CPU runs the group as one loop anyway */
     uint total = 0u;
     for (uint i = 0u; i < WP_GROUP_SIZE; ++i) {
       const uint flag = scan[i];
@@ -84,6 +57,21 @@ static inline void queue_push_group2(Queues qs, uint qa, bool push_a, uint qb, b
   const uint rank = scan[lid];
   if (push_a) qs.slots[qa * qs.capacity + scan[WP_GROUP_SIZE] + (rank & 0xffffu)] = slot;
   if (push_b) qs.slots[qb * qs.capacity + scan[WP_GROUP_SIZE + 1u] + (rank >> 16)] = slot;
+}
+
+/* Appends `slot` to queue `q` where `push` holds, for the whole work-group at once: a scan of the
+ * group's flags in local memory, one atomic add on the queue's counter per group, and each pushing
+ * work-item writes its entry at the group's base plus its rank. One atomic per work-item instead
+ * cost half the time of shade_surface and roulette_compact on PoCL (a locked add on a counter the
+ * other cores share, which also waits for the work-item's earlier stores to drain).
+ *
+ * It holds barriers: every work-item of the group must call it, in the same order as the others,
+ * none having returned before. `scan` is the kernel's WP_GROUP_SCRATCH (WP_GROUP_SIZE + 2 words).
+ * It is queue_push_group2 with one queue.
+ * The rank is the work-item's order in its group, so a queue's order still depends on which group
+ * reached the counter first (nothing may depend on it; see the top of this file). */
+static inline void queue_push_group(Queues qs, uint q, bool push, uint slot, __local uint* scan) {
+  queue_push_group2(qs, q, push, q, false, slot, scan);
 }
 
 /* A stage kernel that pushes to queues: launched with exactly WP_GROUP_SIZE work-items per group,

@@ -66,12 +66,15 @@ static inline Rng rng_make(uint pixel, uint sample, uint seed, uint bounce) {
   return r;
 }
 
-/* The 32 random bits of dimension `dim`. */
-static inline uint rng_bits(Rng r, uint dim) {
-  uint h = wp_hash(r.bounce * WP_DIMS_PER_BOUNCE + dim + wp_hash(r.seed));
-  h = wp_hash(h ^ r.sample);
-  return wp_hash(h ^ r.pixel);
-}
+/* The 32 random bits of dimension `dim` (rng_bits8: of eight dimensions at once). */
+#define WP_RNG_DEFINE_BITS(T, suffix)                                             \
+  static inline T rng_bits##suffix(Rng r, T dim) {                                \
+    T h = wp_hash##suffix(r.bounce * WP_DIMS_PER_BOUNCE + dim + wp_hash(r.seed)); \
+    h = wp_hash##suffix(h ^ r.sample);                                            \
+    return wp_hash##suffix(h ^ r.pixel);                                          \
+  }
+WP_RNG_DEFINE_BITS(uint, )
+WP_RNG_DEFINE_BITS(uint8, 8)
 
 /* The top 23 bits as the midpoint of their cell: an odd multiple of 2^-24 in (0, 1), never 0 or 1,
  * so no sample lands exactly on the edge of a domain (a triangle's side, a pole). Exact in float,
@@ -215,9 +218,7 @@ static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
 /* As the Sobol' rng_bounce; here a pair's second number is the next dimension's (rng_get2). */
 static inline __attribute__((always_inline)) float8 rng_bounce(Rng r) {
   const uint8 dim = WP_BOUNCE_GROUPS - as_uint8(WP_BOUNCE_SECOND); /* -(-1): the pair's next */
-  uint8 h = wp_hash8(r.bounce * WP_DIMS_PER_BOUNCE + dim + wp_hash(r.seed));
-  h = wp_hash8(h ^ r.sample);
-  return rng_float8(wp_hash8(h ^ r.pixel));
+  return rng_float8(rng_bits8(r, dim));
 }
 
 static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
