@@ -42,9 +42,10 @@
 #define WP_DIM_ALPHA_SHADOW 10u /* ... and of the shadow ray */
 #define WP_DIMS_PER_BOUNCE 16u
 
-/* The integer functions below are defined once for uint and once for uint8 (suffix 8): the uint8
- * versions draw all of a bounce's numbers at once (rng_bounce), eight lanes in one SIMD register on
- * a CPU, the same numbers bit for bit. */
+/* The integer functions below are defined for uint and uint8 (suffix 8), the hash and the Sobol'
+ * helpers also for uint2 (suffix 2): the vector versions draw a pair (rng_get2) or all of a
+ * bounce's numbers (rng_bounce) at once, in the lanes of one SIMD register on a CPU, the same
+ * numbers bit for bit. */
 #define WP_RNG_DEFINE_HASH(T, suffix)    \
   static inline T wp_hash##suffix(T x) { \
     x ^= x >> 16;                        \
@@ -55,6 +56,7 @@
     return x;                            \
   }
 WP_RNG_DEFINE_HASH(uint, )
+WP_RNG_DEFINE_HASH(uint2, 2)
 WP_RNG_DEFINE_HASH(uint8, 8)
 
 typedef struct Rng {
@@ -150,17 +152,12 @@ static inline float8 rng_float8(uint8 bits) {
  * block of 2^(j+1) coefficients adds its upper half to its lower one). The result is the point with
  * its digits reversed, which is what Owen scrambling permutes (rng_owen) before reversing. */
 WP_RNG_DEFINE_SOBOL(uint, )
+WP_RNG_DEFINE_SOBOL(uint2, 2)
 WP_RNG_DEFINE_SOBOL(uint8, 8)
 
 /* The scramble keys of a group's first and second dimensions, from its seed. */
 #define WP_KEY_FIRST 0x5bd1e995u
 #define WP_KEY_SECOND 0x1b873593u
-
-/* The second Sobol' dimension, Owen-scrambled. */
-static inline uint rng_sobol_second(uint index, uint seed) {
-  return rng_reverse_bits(
-      rng_nested_permute(rng_taylor_shift(index), wp_hash(seed ^ WP_KEY_SECOND)));
-}
 
 /* The first Sobol' dimension, van der Corput, Owen-scrambled: owen(reverse(i)) =
  * reverse(permute(i)). */
@@ -187,12 +184,17 @@ static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
   return rng_float(rng_van_der_corput(index, seed));
 }
 
-/* Two-dimensional group (dim, dim + 1): the scrambled point of the first two Sobol' dimensions. */
+/* Two-dimensional group (dim, dim + 1): the scrambled point of the first two Sobol' dimensions,
+ * the first (van der Corput) and the second (its digits from rng_taylor_shift) in the two lanes of
+ * a uint2, each with its own key, as rng_bounce does eight at a time (generate_camera_rays
+ * 0.027 s -> 0.022 s on the Cornell box, 128 x 128, 96 spp, --profile, medians of 5). */
 static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
   const uint seed = rng_group_seed(r, dim);
   const uint index = rng_owen(r.sample, seed);
-  return (float2)(rng_float(rng_van_der_corput(index, seed)),
-                  rng_float(rng_sobol_second(index, seed)));
+  const uint2 digits = (uint2)(index, rng_taylor_shift(index));
+  const uint2 key = wp_hash2(seed ^ (uint2)(WP_KEY_FIRST, WP_KEY_SECOND));
+  const uint2 bits = rng_reverse_bits2(rng_nested_permute2(digits, key));
+  return (float2)(rng_float(bits.x), rng_float(bits.y));
 }
 
 /* All of a bounce's numbers (lanes: WP_BOUNCE_GROUPS), each exactly what rng_get or rng_get2 gives
