@@ -176,14 +176,21 @@ std::optional<Bvh> cache_load(const std::string& dir, std::uint64_t key, std::si
   return b;
 }
 
-void cache_store(const std::string& dir, std::uint64_t key, const Bvh& b) {
-  if (dir.empty()) return;
+bool write_file_atomically(const std::string& path, const std::function<bool(std::FILE*)>& write) {
   std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  const std::string path = entry_path(dir, key);
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   const std::string temp = path + ".tmp" + std::to_string(std::random_device{}());
   std::FILE* f = std::fopen(temp.c_str(), "wb");
-  if (!f) return;
+  if (!f) return false;
+  bool ok = write(f);
+  ok &= std::fclose(f) == 0;
+  if (ok) std::filesystem::rename(temp, path, ec);
+  if (!ok || ec) std::filesystem::remove(temp, ec);
+  return ok && !ec;
+}
+
+void cache_store(const std::string& dir, std::uint64_t key, const Bvh& b) {
+  if (dir.empty()) return;
   CacheHeader h{};
   std::memcpy(h.magic, kMagic, 8);
   h.key = key;
@@ -199,14 +206,13 @@ void cache_store(const std::string& dir, std::uint64_t key, const Bvh& b) {
   h.counts[1] = b.triangles.size();
   h.counts[2] = b.nodes8.size();
   h.counts[3] = b.blocks.size();
-  Hasher sum;
-  sum.bytes(&h, sizeof h);
-  bool ok = std::fwrite(&h, sizeof h, 1, f) == 1 && write_array(f, b.nodes, sum) &&
-            write_array(f, b.triangles, sum) && write_array(f, b.nodes8, sum) &&
-            write_array(f, b.blocks, sum) && std::fwrite(&sum.h, sizeof sum.h, 1, f) == 1;
-  ok &= std::fclose(f) == 0;
-  if (ok) std::filesystem::rename(temp, path, ec);
-  if (!ok || ec) std::filesystem::remove(temp, ec);
+  write_file_atomically(entry_path(dir, key), [&](std::FILE* f) {
+    Hasher sum;
+    sum.bytes(&h, sizeof h);
+    return std::fwrite(&h, sizeof h, 1, f) == 1 && write_array(f, b.nodes, sum) &&
+           write_array(f, b.triangles, sum) && write_array(f, b.nodes8, sum) &&
+           write_array(f, b.blocks, sum) && std::fwrite(&sum.h, sizeof sum.h, 1, f) == 1;
+  });
 }
 
 Bvh build_cached(const BuildInput& input, const BuildOptions& options, const std::string& dir,

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <optional>
 #include <string>
@@ -38,6 +39,11 @@ std::uint64_t cache_key(const BuildInput& input, const BuildOptions& options);
 // Where entries live: $WAVEPATH_CACHE_DIR, else $XDG_CACHE_HOME/wavepath, else
 // $HOME/.cache/wavepath; empty when none can be determined (then nothing is cached).
 std::string cache_dir();
+
+// Writes the file at `path` (creating its folder) through `write`, aside under a temporary name
+// renamed into place, so that a reader never sees half a file; false (and nothing left behind) if
+// `write` or any step fails. Shared with the kernel program cache (host/program_cache.h).
+bool write_file_atomically(const std::string& path, const std::function<bool(std::FILE*)>& write);
 
 // The entry `key` for a scene of `triangle_count` triangles built with `options`, or nullopt when
 // it is missing or fails any of the checks above.

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "host/error.h"
+#include "host/program_cache.h"
 
 namespace wp {
 
@@ -191,8 +192,35 @@ ClRuntime::ClRuntime(const DeviceEntry& device) : device_(device) {
   }
 }
 
-cl::Program ClRuntime::build(const std::string& source, const std::string& options) {
+cl::Program ClRuntime::build(const std::string& source, const std::string& options,
+                             const std::string& cache_dir) {
   const auto start = std::chrono::steady_clock::now();
+  const auto add_time = [&] {
+    build_seconds_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  cached_build_ = false;
+  std::uint64_t key = 0;
+  if (!cache_dir.empty()) {
+    std::string driver;
+    try {
+      driver = device_.device.getInfo<CL_DRIVER_VERSION>();
+    } catch (const cl::Error&) {
+    }
+    key = program_cache_key(device_, driver, source, options);
+    if (auto binary = program_cache_load(cache_dir, key)) {
+      try {
+        StderrCapture quiet;
+        cl::Program cached(context_, {device_.device}, cl::Program::Binaries{std::move(*binary)});
+        cached.build({device_.device}, options.c_str());
+        cached_build_ = true;
+        add_time();
+        return cached;
+      } catch (const cl::Error&) {
+        // Refused (another driver build, say): built from source below, and the entry replaced.
+      }
+    }
+  }
   cl::Program program(context_, source);
   try {
     StderrCapture quiet;
@@ -206,7 +234,15 @@ cl::Program ClRuntime::build(const std::string& source, const std::string& optio
     throw Error("kernel build failed on " + device_.name + ": " + first_error_line(log),
                 "OpenCL build log (options: " + options + "):\n" + trim(log));
   }
-  build_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!cache_dir.empty()) {
+    try {
+      const auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
+      if (binaries.size() == 1) program_cache_store(cache_dir, key, binaries[0]);
+    } catch (const cl::Error&) {
+      // An implementation without binaries: nothing to cache.
+    }
+  }
+  add_time();
   return program;
 }
 

@@ -51,15 +51,20 @@ class ClRuntime {
 
   // Builds `source` with `options` for this device. On failure throws wp::Error naming the device
   // and the first error line, with the whole build log as details. The time spent is added to
-  // build_seconds().
-  cl::Program build(const std::string& source, const std::string& options);
+  // build_seconds(). With a `cache_dir` the program is built from the binary cached there when
+  // there is one the device accepts (host/program_cache.h), and its binary is stored there after a
+  // build from source; cached_build() tells which happened last.
+  cl::Program build(const std::string& source, const std::string& options,
+                    const std::string& cache_dir = {});
   double build_seconds() const { return build_seconds_; }
+  bool cached_build() const { return cached_build_; }
 
  private:
   DeviceEntry device_;
   cl::Context context_;
   cl::CommandQueue queue_;
   double build_seconds_ = 0.0;
+  bool cached_build_ = false;
 };
 
 }  // namespace wp

@@ -20,6 +20,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bvh/bvh_cache.h"
 #include "host/cl_runtime.h"
 #include "host/distributed.h"
 #include "host/environment.h"
@@ -49,6 +50,7 @@ struct CliOptions {
   bool variance = false;
   bool no_bvh_cache = false;
   bool no_prefetch = false;
+  bool no_kernel_cache = false;
   std::string features = "scene";
   std::string tonemap = "aces";
   float exposure = 0.0f;
@@ -302,6 +304,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   settings.sampler = cli.sampler == "independent" ? wp::Sampler::kIndependent : wp::Sampler::kSobol;
   settings.fused = cli.pipeline == "fused";
   settings.prefetch = !cli.no_prefetch;
+  if (!cli.no_kernel_cache) settings.kernel_cache_dir = wp::bvh::cache_dir();
   if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);
   if (!cli.env.empty())
@@ -659,6 +662,9 @@ int main(int argc, char** argv) {
   render->add_flag("--no-bvh-cache", cli.no_bvh_cache,
                    "Build the BVH afresh; by default it is looked up in and stored to "
                    "$WAVEPATH_CACHE_DIR, else $XDG_CACHE_HOME/wavepath, else ~/.cache/wavepath");
+  render->add_flag("--no-kernel-cache", cli.no_kernel_cache,
+                   "Build the kernels from source; by default the built program is looked up in "
+                   "and stored to the BVH cache's folder (~20 ms less start-up on PoCL)");
   render->add_flag("--variance", cli.variance,
                    "Also write the variance of each pixel's estimate (sample variance / spp): the "
                    "layer variance.R/G/B in EXR output, X.variance.pfm beside X.pfm");

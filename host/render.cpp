@@ -175,6 +175,7 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   r.triangles = scene.triangle_count();
   r.bvh = bvh.stats;
   r.bvh_cached = cached;
+  r.kernel_cached = wavefront.kernel_cached();
   r.kernel_build_seconds = wavefront.build_seconds();
   r.kernel_binary_bytes = wavefront.binary_bytes();
   r.setup_seconds = since(start);

@@ -35,8 +35,9 @@ struct RenderReport {
   std::string features;       // the kernel features the program was built with
   std::string build_options;  // the program's build options
   std::size_t triangles = 0;
-  bvh::BuildStats bvh;      // build_seconds: of the build, or of the cache look-up when cached
-  bool bvh_cached = false;  // loaded from the BVH cache (bvh/bvh_cache.h)
+  bvh::BuildStats bvh;         // build_seconds: of the build, or of the cache look-up when cached
+  bool bvh_cached = false;     // loaded from the BVH cache (bvh/bvh_cache.h)
+  bool kernel_cached = false;  // the program built from the kernel cache (host/program_cache.h)
   double kernel_build_seconds = 0;  // includes the OpenCL implementation's cache lookup
   std::size_t kernel_binary_bytes = 0;
   double setup_seconds = 0;       // BVH, upload, program: from scene to first pass

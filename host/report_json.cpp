@@ -98,6 +98,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"bvh_build_seconds\":" << num(r.bvh.build_seconds)
     << ",\"bvh_sah_cost\":" << num(r.bvh.sah_cost)
     << ",\"bvh_cached\":" << (r.bvh_cached ? "true" : "false")
+    << ",\"kernel_cached\":" << (r.kernel_cached ? "true" : "false")
     << ",\"setup_seconds\":" << num(r.setup_seconds)
     << ",\"first_pass_seconds\":" << num(r.first_pass_seconds)
     << ",\"load_seconds\":" << num(load_seconds) << ",\"total_seconds\":" << num(total_seconds)

@@ -130,7 +130,8 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   const auto build_start = std::chrono::steady_clock::now();
   const std::string source = program_source();
   source_digest_ = fnv1a64(source.data(), source.size());
-  program_ = rt_.build(source, options_);
+  program_ = rt_.build(source, options_, settings.kernel_cache_dir);
+  kernel_cached_ = rt_.cached_build();
   try {
     for (int i = 0; i < kStageCount; ++i) {
       cl::Kernel& k = kernels_.emplace_back(program_, kStageNames[i]);

@@ -69,6 +69,9 @@ struct RenderSettings {
   // WP_PREFETCH); elsewhere nothing. The same image either way.
   bool prefetch = true;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
+  // Where built kernel programs are cached (host/program_cache.h; the command line passes
+  // bvh::cache_dir()); empty: nothing is cached.
+  std::string kernel_cache_dir;
   // Most bytes in one scene buffer (device_scene.h); 0: the device's largest allocation. Smaller
   // values split even small scenes over several buffers (tests).
   std::uint64_t scene_buffer_bytes = 0;
@@ -174,6 +177,8 @@ class Wavefront {
   // Size of the device program binary (implementation-specific: LLVM bitcode on PoCL, PTX on
   // NVIDIA), 0 if the implementation does not report one.
   std::size_t binary_bytes() const { return binary_bytes_; }
+  // Whether the program came from the kernel cache (RenderSettings::kernel_cache_dir).
+  bool kernel_cached() const { return kernel_cached_; }
 
  private:
   void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
@@ -193,6 +198,7 @@ class Wavefront {
   std::size_t local_size_ = 0;
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;
+  bool kernel_cached_ = false;
   std::uint64_t rays_traced_ = 0;
   std::string options_;
   std::uint64_t source_digest_ = 0;
