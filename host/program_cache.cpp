@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 #include "bvh/bvh_cache.h"
 #include "host/cl_runtime.h"
@@ -52,12 +53,14 @@ std::optional<std::vector<unsigned char>> program_cache_load(const std::string& 
   if (!f) return std::nullopt;
   std::optional<std::vector<unsigned char>> out;
   Header h{};
-  if (std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, kMagic, 8) == 0 && h.key == key &&
-      h.size > 0 && h.size <= kMaxBinary) {
+  // The size must be the file's (checked before anything is allocated), the checksum the bytes'.
+  std::error_code ec;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(program_cache_path(dir, key), ec);
+  if (!ec && std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, kMagic, 8) == 0 &&
+      h.key == key && h.size > 0 && h.size <= kMaxBinary && file_bytes == sizeof h + h.size) {
     std::vector<unsigned char> bytes(h.size);
-    unsigned char extra;
     if (std::fread(bytes.data(), 1, bytes.size(), f) == bytes.size() &&
-        std::fread(&extra, 1, 1, f) == 0 && fnv1a64(bytes.data(), bytes.size()) == h.checksum)
+        fnv1a64(bytes.data(), bytes.size()) == h.checksum)
       out = std::move(bytes);
   }
   std::fclose(f);

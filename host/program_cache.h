@@ -4,10 +4,11 @@
 // find them (~23 ms of a 0.06 s start-up on the Cornell box); from a binary the build takes ~5 ms.
 //
 // An entry is keyed by a 64-bit hash of everything the binary depends on: the source, the build
-// options, and the device (platform name and version, device name and version, driver version).
-// A missing, truncated or corrupted entry (the file's checksum) is a miss, never an error; so is a
-// binary the implementation refuses (ClRuntime::build then builds from source and overwrites it);
-// a failed write is ignored. Entries live beside the BVH cache's (bvh::cache_dir()).
+// options, and the device (platform name, device name and version, driver version). A missing,
+// truncated or corrupted entry (its size against the file's, checked before anything is
+// allocated, and a checksum of the binary) is a miss, never an error; so is a binary the
+// implementation refuses (ClRuntime::build then builds from source and overwrites it); a failed
+// write is ignored. Entries live beside the BVH cache's (bvh::cache_dir()).
 #pragma once
 
 #include <cstdint>

@@ -99,6 +99,11 @@ TEST_F(ProgramCache, CorruptedOrTruncatedEntryIsAMissAndIsReplaced) {
   flip_byte(0);  // the magic
   EXPECT_FALSE(build_and_check());
   EXPECT_TRUE(build_and_check());
+  flip_byte(16 + 2);  // the size field: it claims megabytes more or fewer than the file holds
+  EXPECT_FALSE(wp::program_cache_load(
+      dir_, wp::program_cache_key(runtime_->device(), driver(), kSource, kOptions)));
+  EXPECT_FALSE(build_and_check());
+  EXPECT_TRUE(build_and_check());
 }
 
 TEST_F(ProgramCache, BinaryTheDeviceRefusesIsAMissAndIsReplaced) {
