@@ -120,7 +120,8 @@ std::vector<char*> c_strings(std::vector<std::string>& v) {
   return out;
 }
 
-// Runs this executable as a startup probe with its kernel cache in `cache_dir`.
+// Runs this executable as a startup probe with its kernel caches (the driver's and wavepath's
+// program cache) in `cache_dir`.
 ProbeResult probe(const SceneSpec& spec, const std::string& cache_dir) {
   const Options& o = env().options;
   std::vector<std::string> args = {"/proc/self/exe",
@@ -128,7 +129,8 @@ ProbeResult probe(const SceneSpec& spec, const std::string& cache_dir) {
                                    spec.path,
                                    std::to_string(o.width),
                                    std::to_string(o.height),
-                                   std::to_string(env().device.index)};
+                                   std::to_string(env().device.index),
+                                   cache_dir};
   std::vector<std::string> vars = probe_environment(cache_dir);
   std::vector<char*> argv = c_strings(args), envp = c_strings(vars);
   int out[2];
@@ -203,8 +205,9 @@ void register_end_to_end_benchmarks(const SceneSpec& scene) {
 // the first finished pass counts from here (device discovery and glTF loading included).
 int run_startup_probe(int argc, char** argv) {
   const auto start = Clock::now();
-  if (argc != 6) {
-    std::fprintf(stderr, "usage: wavepath-bench %s SCENE WIDTH HEIGHT DEVICE\n", kStartupProbe);
+  if (argc != 7) {
+    std::fprintf(stderr, "usage: wavepath-bench %s SCENE WIDTH HEIGHT DEVICE CACHE_DIR\n",
+                 kStartupProbe);
     return 2;
   }
   try {
@@ -214,6 +217,7 @@ int run_startup_probe(int argc, char** argv) {
     const Scene scene = load_gltf(argv[2]);
     RenderSettings settings = bench_settings(false);
     settings.spp = 1;
+    settings.kernel_cache_dir = argv[6];  // as `wavepath render` keeps it (host/program_cache.h)
     const double before_render = since(start);
     const Rendered r = render(runtime, scene, settings);
     std::printf("build_seconds=%.9f first_pass_seconds=%.9f\n", r.report.kernel_build_seconds,
