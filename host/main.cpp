@@ -664,7 +664,7 @@ int main(int argc, char** argv) {
                    "$WAVEPATH_CACHE_DIR, else $XDG_CACHE_HOME/wavepath, else ~/.cache/wavepath");
   render->add_flag("--no-kernel-cache", cli.no_kernel_cache,
                    "Build the kernels from source; by default the built program is looked up in "
-                   "and stored to the BVH cache's folder (~20 ms less start-up on PoCL)");
+                   "and stored to the BVH cache's folder (~25 ms less start-up on PoCL)");
   render->add_flag("--variance", cli.variance,
                    "Also write the variance of each pixel's estimate (sample variance / spp): the "
                    "layer variance.R/G/B in EXR output, X.variance.pfm beside X.pfm");
