@@ -301,7 +301,9 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
       cli.heuristic == "balance" ? wp::MisHeuristic::kBalance : wp::MisHeuristic::kPower;
   settings.light_select =
       cli.light_select == "uniform" ? wp::LightSelect::kUniform : wp::LightSelect::kPower;
-  settings.sampler = cli.sampler == "independent" ? wp::Sampler::kIndependent : wp::Sampler::kSobol;
+  settings.sampler = cli.sampler == "independent"    ? wp::Sampler::kIndependent
+                     : cli.sampler == "sobol-padded" ? wp::Sampler::kSobolPadded
+                                                     : wp::Sampler::kSobol;
   settings.fused = cli.pipeline == "fused";
   settings.prefetch = !cli.no_prefetch;
   if (!cli.no_kernel_cache) settings.kernel_cache_dir = wp::bvh::cache_dir();
@@ -619,8 +621,10 @@ int main(int argc, char** argv) {
   render
       ->add_option("--sampler", cli.sampler,
                    "Sample pattern: sobol (Owen-scrambled Sobol' points per pixel: less error "
-                   "for the same samples) or independent (a hash per random number)")
-      ->check(CLI::IsMember({"sobol", "independent"}))
+                   "for the same samples; a light sample stratified jointly with the ray that "
+                   "found the surface), sobol-padded (the same points, every group of numbers "
+                   "in an order of its own) or independent (a hash per random number)")
+      ->check(CLI::IsMember({"sobol", "sobol-padded", "independent"}))
       ->capture_default_str();
   render
       ->add_option("--pipeline", cli.pipeline,

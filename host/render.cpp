@@ -81,10 +81,10 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
                                        : "bsdf")
     << ";mis_heuristic=" << (s.mis_heuristic == MisHeuristic::kPower ? "power" : "balance")
     << ";light_select=" << (s.light_select == LightSelect::kPower ? "power" : "uniform")
-    << ";sampler=" << (s.sampler == Sampler::kSobol ? "sobol" : "independent")
-    << ";camera=" << s.camera << ";features=" << (s.all_features ? "all" : "scene")
-    << ";bvh_width=" << bvh_width << ";spatial_splits=" << (spatial_splits ? 1 : 0)
-    << ";aov=" << (s.aov ? 1 : 0) << ";kernels=" << hex64(kernel_digest);
+    << ";sampler=" << sampler_name(s.sampler) << ";camera=" << s.camera
+    << ";features=" << (s.all_features ? "all" : "scene") << ";bvh_width=" << bvh_width
+    << ";spatial_splits=" << (spatial_splits ? 1 : 0) << ";aov=" << (s.aov ? 1 : 0)
+    << ";kernels=" << hex64(kernel_digest);
   return k.str();
 }
 

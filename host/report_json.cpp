@@ -63,7 +63,7 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
                                                                : "bsdf"},
           {"wavepath:mis_heuristic", s.mis_heuristic == MisHeuristic::kPower ? "power" : "balance"},
           {"wavepath:light_select", s.light_select == LightSelect::kPower ? "power" : "uniform"},
-          {"wavepath:sampler", s.sampler == Sampler::kSobol ? "sobol" : "independent"},
+          {"wavepath:sampler", sampler_name(s.sampler)},
           {"wavepath:environment", s.environment ? s.environment->source : std::string("constant")},
           {"wavepath:env_intensity", num(s.env_intensity)},
           {"wavepath:env_rotation", num(s.env_rotation)},

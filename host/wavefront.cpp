@@ -12,6 +12,18 @@
 
 namespace wp {
 
+const char* sampler_name(Sampler s) {
+  switch (s) {
+    case Sampler::kSobol:
+      return "sobol";
+    case Sampler::kSobolPadded:
+      return "sobol-padded";
+    case Sampler::kIndependent:
+      break;
+  }
+  return "independent";
+}
+
 namespace {
 
 // The one place where program build options are assembled: the scene's features and the
@@ -24,7 +36,10 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
   o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
-  o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kSobol ? "1" : "0");
+  // kernels/features.h's WP_SAMPLER_INDEPENDENT, _SOBOL and _SOBOL_PADDED.
+  o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kIndependent ? "0"
+                                         : s.sampler == Sampler::kSobol     ? "1"
+                                                                            : "2");
   if (s.aov) o += " -D WP_AOV=1";
   return o;
 }

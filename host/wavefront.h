@@ -27,8 +27,12 @@ namespace wp {
 
 enum class Strategy { kMis, kNee, kBsdf };
 enum class MisHeuristic { kPower, kBalance };
-// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points or independent hashes.
-enum class Sampler { kSobol, kIndependent };
+// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points, the light pair chained to the ray
+// that found the surface (kSobol) or in an order of its own like every other group
+// (kSobolPadded), or independent hashes.
+enum class Sampler { kSobol, kIndependent, kSobolPadded };
+// The --sampler name of a pattern ("sobol", "independent", "sobol-padded").
+const char* sampler_name(Sampler s);
 
 struct RenderSettings {
   int width = 640;

@@ -68,7 +68,7 @@ def config_args(config):
             args += ["--rr-depth", value]
         elif key == "depth" and value.isdigit():
             args += ["--max-depth", value]
-        elif key == "sampler" and value in ("independent", "sobol"):
+        elif key == "sampler" and value in ("independent", "sobol", "sobol-padded"):
             sampler = value
         else:
             raise ValueError("configuration %r: unknown setting %r" % (config, part))
