@@ -621,8 +621,8 @@ int main(int argc, char** argv) {
   render
       ->add_option("--sampler", cli.sampler,
                    "Sample pattern: sobol (Owen-scrambled Sobol' points per pixel: less error "
-                   "for the same samples; a light sample stratified jointly with the ray that "
-                   "found the surface), sobol-padded (the same points, every group of numbers "
+                   "for the same samples; the light and BSDF samples of successive bounces "
+                   "stratified together), sobol-padded (the same points, every group of numbers "
                    "in an order of its own) or independent (a hash per random number)")
       ->check(CLI::IsMember({"sobol", "sobol-padded", "independent"}))
       ->capture_default_str();

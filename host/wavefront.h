@@ -27,8 +27,8 @@ namespace wp {
 
 enum class Strategy { kMis, kNee, kBsdf };
 enum class MisHeuristic { kPower, kBalance };
-// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points, the light pair chained to the ray
-// that found the surface (kSobol) or in an order of its own like every other group
+// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points, the light and BSDF pairs of two
+// bounces chained to one sample order (kSobol) or every group in an order of its own
 // (kSobolPadded), or independent hashes.
 enum class Sampler { kSobol, kIndependent, kSobolPadded };
 // The --sampler name of a pattern ("sobol", "independent", "sobol-padded").

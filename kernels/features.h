@@ -42,8 +42,8 @@
 #define WP_FEATURE_VOLUME 1 /* KHR_materials_volume: refraction and absorption */
 #endif
 
-/* Sample pattern (rng.h): Owen-scrambled Sobol' (the light pair chained to the ray's pair, or
- * padded: every group in an order of its own) or independent hashes. */
+/* Sample pattern (rng.h): Owen-scrambled Sobol' (the light and BSDF pairs of two bounces chained
+ * to one order, or padded: every group in an order of its own) or independent hashes. */
 #define WP_SAMPLER_INDEPENDENT 0
 #define WP_SAMPLER_SOBOL 1
 #define WP_SAMPLER_SOBOL_PADDED 2

@@ -3,11 +3,10 @@
 // - uniformity: over many pixels, the numbers each dimension group draws at a given sample index
 //   and bounce are uniform on [0,1) or [0,1)^2 (chi-square), for both patterns;
 // - stratification (Sobol): every aligned block of 2^k samples of one pixel puts exactly one point
-//   in every elementary interval of area 2^-k (one per 2^-k interval in 1D), k <= 10; the light
-//   pair, chained to the pair that chose the ray (rng.h, rng_chained_group), has exactly the
-//   t-values of Sobol' dimensions 2 and 3 alone and of dimensions 0-3 together with that pair,
-//   those computed here from Joe and Kuo's direction numbers; the kernel's table of those
-//   dimensions equals the recurrence;
+//   in every elementary interval of area 2^-k (one per 2^-k interval in 1D), k <= 10; the chained
+//   pairs (rng.h, rng_pair_source) have exactly the t-values of the Sobol' dimensions they take,
+//   alone and with the pairs they are chained to, those computed here from Joe and Kuo's
+//   direction numbers; the kernel's table of dimensions 2-7 equals the recurrence;
 // - range: every number is in the open interval (0, 1);
 // - independence: numbers of different groups, bounces or neighbouring pixels are independent
 //   (chi-square of their joint histogram), for both patterns; without the per-group shuffle of
@@ -15,9 +14,10 @@
 // - the payoff: integrating a smooth function with 256 Sobol' points per pixel has an error far
 //   below the independent pattern's, and both are unbiased.
 //
-// False alarms: each chi-square passes at p > 1e-4; with the 128 of them here a correct pattern
-// fails a run with probability below 1.3% (union bound). The seed is fixed, so a build passes or
-// fails reproducibly.
+// False alarms: each uniformity chi-square passes at p > 1e-4 (144 of them), each independence case
+// at most 10 of 64 pixels at p < 1e-3 (24 cases, see the test); a correct pattern fails a run with
+// probability below 1.8% (union bound). The seed is fixed, so a build passes or fails
+// reproducibly.
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -52,7 +52,7 @@ struct Coord {
 
 class Patterns {
  public:
-  // WP_SAMPLER: 0 independent, 1 Sobol' (the light pair chained), 2 Sobol' padded.
+  // WP_SAMPLER: 0 independent, 1 Sobol' (pairs chained), 2 Sobol' padded.
   static Patterns& get(int sampler) {
     static Patterns independent(0), sobol(1), padded(2);
     return sampler == 1 ? sobol : sampler == 2 ? padded : independent;
@@ -69,11 +69,12 @@ class Patterns {
     return h_.read<cl_float2>(out, n);
   }
 
-  // The kernel's reversed digits of Sobol' dimensions 2 and 3 of each index (Sobol build only).
-  std::vector<cl_uint2> sobol23(const std::vector<std::uint32_t>& indices) {
+  // The kernel's reversed digits of Sobol' dimensions 2p and 2p + 1 of each index (Sobol' builds
+  // only).
+  std::vector<cl_uint2> sobol_pair(const std::vector<std::uint32_t>& indices, std::uint32_t p) {
     const auto n = static_cast<std::uint32_t>(indices.size());
     cl::Buffer out = h_.buffer<cl_uint2>(n);
-    h_.run("sobol23_digits", n, h_.buffer(indices), n, out);
+    h_.run("sobol_pair_digits", n, h_.buffer(indices), p, n, out);
     return h_.read<cl_uint2>(out, n);
   }
 
@@ -138,15 +139,17 @@ TEST(Rng, EveryGroupIsUniformOverPixels) {
 
 // Sobol: samples [b 2^k, (b+1) 2^k) of one pixel, for k = 0..10 and blocks b = 0, 1, 5: exactly
 // one point in each of the 2^k elementary intervals of every shape 2^a x 2^(k-a) (pairs), or in
-// each interval of length 2^-k (one number). Both Sobol' patterns; the chained one's light pair
-// is the test after this one's.
+// each interval of length 2^-k (one number). Both Sobol' patterns; of the chained one, not the
+// pairs that take higher dimensions (the test after this one).
 TEST(Rng, SobolStratifiesEveryAlignedBlockOfSamples) {
   constexpr std::uint32_t kSamples = 6u << 10;
   for (int sampler : {1, 2})
     for (std::uint32_t pixel : {0u, 1u, 12345u, (1u << 20) + 7u})
       for (std::uint32_t bounce : {0u, 3u, 11u})
         for (const Group& g : kGroups) {
-          if (sampler == 1 && std::string(g.name) == "light_uv") continue;
+          const std::string name = g.name;
+          if (sampler == 1 && (name == "light_uv" || (name == "bsdf_uv" && bounce % 2 == 1)))
+            continue;
           std::vector<Coord> coords;
           for (std::uint32_t s = 0; s < kSamples; ++s) coords.push_back({pixel, s, bounce, g});
           const auto v = Patterns::get(sampler).draw(coords);
@@ -170,18 +173,21 @@ TEST(Rng, SobolStratifiesEveryAlignedBlockOfSamples) {
         }
 }
 
-// Sobol' dimension d (0-3) of index i as a 32-bit binary fraction (bit 31 the first digit), from
-// Joe and Kuo's direction numbers (new-joe-kuo-6.21201: dimension 2 is x + 1 with m = 1, 3 is
-// x^2 + x + 1 with m = 1, 3 and 4 is x^3 + x + 1 with m = 1, 3, 1; dimension 1 the identity):
-// v_j = m_j / 2^j for j <= s, then v_j = a_1 v_(j-1) ^ ... ^ a_(s-1) v_(j-s+1) ^ v_(j-s) ^
-// v_(j-s) / 2^s, and the point is the xor of v_j over the index's set bits j - 1.
+// Sobol' dimension d (0-7) of index i as a 32-bit binary fraction (bit 31 the first digit), from
+// Joe and Kuo's direction numbers (new-joe-kuo-6.21201, their dimensions 2-8, lines "d s a m_i":
+// 2 1 0 1, 3 2 1 1 3, 4 3 1 1 3 1, 5 3 2 1 1 1, 6 4 1 1 1 3 3, 7 4 4 1 3 5 13, 8 5 2 1 1 5 5 17;
+// their dimension 1, the identity, is d = 0 here): v_j = m_j / 2^j for j <= s, then v_j =
+// a_1 v_(j-1) ^ ... ^ a_(s-1) v_(j-s+1) ^ v_(j-s) ^ v_(j-s) / 2^s, and the point is the xor of v_j
+// over the index's set bits j - 1.
 std::uint32_t sobol(int d, std::uint32_t i) {
   struct Poly {
     int s;
     std::uint32_t a;
-    std::uint32_t m[3];
+    std::uint32_t m[5];
   };
-  static const Poly polys[3] = {{1, 0, {1}}, {2, 1, {1, 3}}, {3, 1, {1, 3, 1}}};
+  static const Poly polys[7] = {
+      {1, 0, {1}},          {2, 1, {1, 3}},        {3, 1, {1, 3, 1}},       {3, 2, {1, 1, 1}},
+      {4, 1, {1, 1, 3, 3}}, {4, 4, {1, 3, 5, 13}}, {5, 2, {1, 1, 5, 5, 17}}};
   std::uint32_t v[32];
   for (int j = 0; j < 32; ++j) {
     if (d == 0) {
@@ -253,77 +259,118 @@ std::uint32_t digits_of(float u) {  // rng_float's 23 bits, back at the top of a
   return static_cast<std::uint32_t>(static_cast<double>(u) * 8388608.0) << 9;
 }
 
-// The kernel's table of Sobol' dimensions 2 and 3 against the recurrence above: every nibble value
-// at every position (the table's entries, which the digits of any index are the xor of) and a
-// spread of whole indices.
-TEST(Rng, ThirdAndFourthSobolDimensionsMatchTheRecurrence) {
+// The kernel's table of Sobol' dimensions 2-7 against the recurrence above: every nibble value at
+// every position (the table's entries, which the digits of any index are the xor of) and a spread
+// of whole indices.
+TEST(Rng, HigherSobolDimensionsMatchTheRecurrence) {
   std::vector<std::uint32_t> indices;
   for (std::uint32_t n = 0; n < 8; ++n)
     for (std::uint32_t v = 0; v < 16; ++v) indices.push_back(v << (4 * n));
   std::uint32_t h = 7;
   for (int i = 0; i < 1000; ++i) indices.push_back(h = h * 1664525u + 1013904223u);
-  const auto got = Patterns::get(1).sobol23(indices);
-  int differ = 0;
-  for (std::size_t i = 0; i < indices.size(); ++i)
-    for (int d = 0; d < 2; ++d) differ += got[i].s[d] != reverse_bits(sobol(2 + d, indices[i]));
-  EXPECT_EQ(differ, 0);
+  for (std::uint32_t p = 1; p <= 3; ++p) {
+    const auto got = Patterns::get(1).sobol_pair(indices, p);
+    int differ = 0;
+    for (std::size_t i = 0; i < indices.size(); ++i)
+      for (int c = 0; c < 2; ++c)
+        differ += got[i].s[c] != reverse_bits(sobol(static_cast<int>(2 * p) + c, indices[i]));
+    EXPECT_EQ(differ, 0) << "dimensions " << 2 * p << ", " << 2 * p + 1;
+  }
 }
 
-// The light pair at bounce b is chained to the pair that chose the ray (the BSDF direction of
-// bounce b - 1, the pixel jitter at bounce 0): over every aligned block of 2^k of a pixel's
-// samples (k <= 10), the light pair's points have the t-value of Sobol' dimensions 2 and 3, and
-// the four numbers together that of dimensions 0-3 (scrambling maps elementary intervals onto
-// elementary intervals, so it keeps t exactly). A light pair drawn in an order of its own would
-// have 4D t-values near k; one from the wrong order, or the wrong dimensions, other t-values.
-TEST(Rng, LightPairIsChainedToTheRayThatFoundTheSurface) {
+// The chained pattern (rng.h, rng_pair_source): over every aligned block of 2^k of a pixel's
+// samples (k <= 10), each chained pair has the t-value of the Sobol' dimensions it takes, and each
+// two pairs chained together that of their four dimensions (scrambling maps elementary intervals
+// onto elementary intervals, so it keeps t exactly): the pixel jitter and the light point at
+// bounce 0 (dimensions 0-3 of one order); for an even bounce b, its BSDF direction (0, 1), the
+// next bounce's direction (2, 3) and light point (4, 5), and the light point at b + 2 (6, 7), with
+// the couples (0-3), (0, 1, 4, 5) and (2, 3, 6, 7). Pairs drawn in orders of their own would have
+// 4D t-values near k; from the wrong order or the wrong dimensions, other t-values.
+TEST(Rng, ChainedPairsHaveTheTValuesOfTheirSobolDimensions) {
   constexpr int kMaxK = 10;
   constexpr std::uint32_t kSamples = 3u << kMaxK;
-  // The t-values of the unscrambled sequence's first 2^k points: the same for every aligned block
-  // (a block is the first one's digitally shifted copy, and shifts keep t).
-  std::vector<int> t2(kMaxK + 1), t4(kMaxK + 1);
-  for (int k = 0; k <= kMaxK; ++k) {
-    std::vector<std::vector<std::uint32_t>> p2, p4;
+  // The t-values of the unscrambled sequence's first 2^k points in the given dimensions: the same
+  // for every aligned block (a block is the first one's digitally shifted copy; shifts keep t).
+  const auto sobol_t = [&](std::vector<int> dims, int k) {
+    std::vector<std::vector<std::uint32_t>> points;
     for (std::uint32_t i = 0; i < 1u << k; ++i) {
-      p2.push_back({sobol(2, i), sobol(3, i)});
-      p4.push_back({sobol(0, i), sobol(1, i), sobol(2, i), sobol(3, i)});
+      std::vector<std::uint32_t> p;
+      for (int d : dims) p.push_back(sobol(d, i));
+      points.push_back(p);
     }
-    t2[static_cast<std::size_t>(k)] = t_value(p2, k);
-    t4[static_cast<std::size_t>(k)] = t_value(p4, k);
-  }
-  EXPECT_GT(t4[kMaxK], 0);  // the test can tell: in 4D no base-2 sequence has t = 0
+    return t_value(points, k);
+  };
+  struct Chain {  // pair a of bounce ba and pair b of bounce bb, Sobol' dimensions da and db
+    const char* name;
+    Group a, b;
+    std::uint32_t ba, bb;  // bounces, relative to the even bounce under test
+    int da, db;            // each pair's first dimension
+  };
   const Group& pixel = kGroups[0];
   const Group& light = kGroups[2];
   const Group& bsdf = kGroups[4];
+  const Chain chains[] = {
+      {"bsdf b / bsdf b+1", bsdf, bsdf, 0, 1, 0, 2},
+      {"bsdf b / light b+1", bsdf, light, 0, 1, 0, 4},
+      {"bsdf b+1 / light b+2", bsdf, light, 1, 2, 2, 6},
+  };
+  std::vector<int> t2[8], t4[8][8];
+  for (int k = 0; k <= kMaxK; ++k)
+    for (int da = 0; da < 8; da += 2) {
+      t2[da].push_back(sobol_t({da, da + 1}, k));
+      for (int db = da + 2; db < 8; db += 2)
+        t4[da][db].push_back(sobol_t({da, da + 1, db, db + 1}, k));
+    }
+  EXPECT_GT(t4[0][2][kMaxK], 0);  // the test can tell: no base-2 4D sequence has t = 0
   for (std::uint32_t p : {0u, 12345u, (1u << 20) + 7u})
-    for (std::uint32_t bounce : {0u, 1u, 3u, 11u}) {
-      std::vector<Coord> coords;
-      for (std::uint32_t s = 0; s < kSamples; ++s) {
-        coords.push_back(bounce == 0 ? Coord{p, s, 0, pixel} : Coord{p, s, bounce - 1, bsdf});
-        coords.push_back({p, s, bounce, light});
-      }
-      const auto v = Patterns::get(1).draw(coords);
-      for (int k = 0; k <= kMaxK; ++k)
-        for (std::uint32_t block : {0u, 1u, 2u}) {
-          const std::uint32_t n = 1u << k, first = block * n;
-          std::vector<std::vector<std::uint32_t>> p2, p4;
-          for (std::uint32_t i = first; i < first + n; ++i) {
-            const cl_float2 a = v[2 * i], l = v[2 * i + 1];
-            p2.push_back({digits_of(l.s[0]), digits_of(l.s[1])});
-            p4.push_back(
-                {digits_of(a.s[0]), digits_of(a.s[1]), digits_of(l.s[0]), digits_of(l.s[1])});
-          }
-          EXPECT_EQ(t_value(p2, k), t2[static_cast<std::size_t>(k)])
-              << "light pair, pixel " << p << " bounce " << bounce << " samples " << first << ".."
-              << first + n - 1;
-          EXPECT_EQ(t_value(p4, k), t4[static_cast<std::size_t>(k)])
-              << "with the ray's pair, pixel " << p << " bounce " << bounce << " samples " << first
-              << ".." << first + n - 1;
+    for (std::uint32_t base : {0u, 2u, 10u}) {
+      std::vector<Chain> cases(std::begin(chains), std::end(chains));
+      if (base == 0) cases.push_back({"pixel / light 0", pixel, light, 0, 0, 0, 2});
+      for (const Chain& c : cases) {
+        std::vector<Coord> coords;
+        for (std::uint32_t s = 0; s < kSamples; ++s) {
+          coords.push_back({p, s, base + c.ba, c.a});
+          coords.push_back({p, s, base + c.bb, c.b});
         }
+        const auto v = Patterns::get(1).draw(coords);
+        for (int k = 0; k <= kMaxK; ++k)
+          for (std::uint32_t block : {0u, 1u, 2u}) {
+            const std::uint32_t n = 1u << k, first = block * n;
+            std::vector<std::vector<std::uint32_t>> pa, pb, pab;
+            for (std::uint32_t i = first; i < first + n; ++i) {
+              const cl_float2 a = v[2 * i], b = v[2 * i + 1];
+              pa.push_back({digits_of(a.s[0]), digits_of(a.s[1])});
+              pb.push_back({digits_of(b.s[0]), digits_of(b.s[1])});
+              pab.push_back(
+                  {digits_of(a.s[0]), digits_of(a.s[1]), digits_of(b.s[0]), digits_of(b.s[1])});
+            }
+            const auto kk = static_cast<std::size_t>(k);
+            const std::string where = std::string(c.name) + ", pixel " + std::to_string(p) +
+                                      ", b = " + std::to_string(base) + ", samples " +
+                                      std::to_string(first) + ".." + std::to_string(first + n - 1);
+            EXPECT_EQ(t_value(pa, k), t2[c.da][kk]) << "first pair: " << where;
+            EXPECT_EQ(t_value(pb, k), t2[c.db][kk]) << "second pair: " << where;
+            EXPECT_EQ(t_value(pab, k), t4[c.da][c.db][kk]) << "together: " << where;
+          }
+      }
     }
 }
 
 // Joint histograms (8 x 8) of two numbers that must be independent: different groups of one
-// pixel's 4096 samples, one group at two bounces, and one group at neighbouring pixels.
+// pixel's 4096 samples, one group at two bounces, and one group at neighbouring pixels; each case
+// at 64 pixels, of which at most 10 may have a chi-square p-value below 10^-3.
+//
+// Why not every pixel: two groups of one pixel take their points in two nested-uniform shuffles of
+// the same sample indices, which keep aligned blocks of indices together (samples 2m and 2m + 1 go
+// to a pair of neighbouring indices in both orders, and so on up), so within one pixel the pairs
+// are not a uniformly random matching and the chi-square statistic has a heavier tail than its
+// distribution: over 1000 pixels per case (2026-11-25), p < 10^-3 at 1.4-2.6% of the pixels for
+// every within-pixel case of both Sobol' patterns, the least p 6e-14, against 0-0.1% and 2e-4 for
+// the independent pattern (the padded pattern was the default for months with these numbers). Over
+// the scrambles, i.e. over pixels, the pairs are independent, which is what an unbiased estimate
+// needs; what this test guards against is systematic dependence -- a missing shuffle makes the two
+// numbers functions of each other in every pixel (p ~ 0 at all 64). False alarms: with a rate of
+// at most 4% per pixel (above the 2.6% seen), P(more than 10 of 64) < 1.4e-4 per case (binomial).
 TEST(Rng, GroupsBouncesAndPixelsAreIndependent) {
   constexpr std::uint32_t kN = 4096;
   struct Case {
@@ -348,8 +395,12 @@ TEST(Rng, GroupsBouncesAndPixelsAreIndependent) {
       {"pixel x / next row's", pixel, pixel, 0, 640},
   };
   for (int sampler : {0, 1, 2})
-    for (const Case& c : cases)
-      for (std::uint32_t p : {3u, 99999u}) {
+    for (const Case& c : cases) {
+      int low = 0;
+      std::string worst;
+      double worst_p = 1.0;
+      for (std::uint32_t i = 0; i < 64; ++i) {
+        const std::uint32_t p = 3u + i * 99991u;
         std::vector<Coord> coords;
         for (std::uint32_t s = 0; s < kN; ++s) {
           // Within a pixel: sample s of both. Across pixels: sample 7 of pixels p + s step apart.
@@ -366,9 +417,13 @@ TEST(Rng, GroupsBouncesAndPixelsAreIndependent) {
           y.push_back(v[2 * s + 1].s[0]);
         }
         const auto r = uniform_2d(x, y, 8, 8);
-        EXPECT_GT(r.p_value, kMinP)
-            << pattern_name(sampler) << " " << c.name << " pixel " << p << ": " << r.detail;
+        low += r.p_value < 1e-3;
+        if (r.p_value < worst_p)
+          worst_p = r.p_value, worst = "pixel " + std::to_string(p) + ": " + r.detail;
       }
+      EXPECT_LE(low, 10) << pattern_name(sampler) << " " << c.name << ": " << low
+                         << " of 64 pixels at p < 1e-3; the least " << worst;
+    }
 }
 
 // rng_bounce, which draws a bounce's numbers eight at a time for the shading kernels, gives each

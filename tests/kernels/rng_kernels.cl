@@ -4,8 +4,8 @@
  *
  * coords[i] = (pixel, sample, bounce, dim | pair << 16); out[i] = rng_get2(r, dim) when pair is 1,
  * else (rng_get(r, dim), 0). draw_bounce: out[i] = rng_bounce(r), all of a bounce's numbers at
- * once (the dim of coords[i] unused). sobol23_digits: out[i] = rng_sobol23_digits(in[i]) (Sobol'
- * build only). */
+ * once (the dim of coords[i] unused). sobol_pair_digits: out[i] = rng_sobol_pair_digits(in[i], p)
+ * (Sobol' builds only). */
 #include "rng.h"
 
 __kernel void draw_rng(__global const uint4* coords, uint seed, uint count, __global float2* out) {
@@ -26,9 +26,9 @@ __kernel void draw_bounce(__global const uint4* coords, uint seed, uint count,
 }
 
 #if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
-__kernel void sobol23_digits(__global const uint* in, uint count, __global uint2* out) {
+__kernel void sobol_pair_digits(__global const uint* in, uint p, uint count, __global uint2* out) {
   const uint i = get_global_id(0);
   if (i >= count) return;
-  out[i] = rng_sobol23_digits(in[i]);
+  out[i] = rng_sobol_pair_digits(in[i], p);
 }
 #endif
