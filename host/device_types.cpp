@@ -26,7 +26,7 @@ static_assert(offsetof(SceneDesc, background) == 80);
 static_assert(offsetof(SceneDesc, env_params) == 96);
 static_assert(offsetof(SceneDesc, bvh_nodes) == 112);
 static_assert(sizeof(SceneDesc) == 224);
-static_assert(sizeof(Launch) == 48);
+static_assert(sizeof(Launch) == 64);
 static_assert(sizeof(PathLayout) % 4 == 0);
 
 }  // namespace wp::dev

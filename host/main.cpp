@@ -638,6 +638,12 @@ int main(int argc, char** argv) {
       ->add_option("--rr-depth", settings.rr_depth,
                    "Russian roulette after this many scattering events")
       ->capture_default_str();
+  render
+      ->add_option("--rr-threshold", settings.rr_threshold,
+                   "Russian roulette ends a path whose throughput (largest channel) m is below "
+                   "this with probability 1 - m / threshold, and a survivor carries the "
+                   "threshold; 1 gives pbrt's rule (survival probability = throughput)")
+      ->capture_default_str();
   render->add_flag("--no-rr", cli.no_rr, "No Russian roulette (paths end only at --max-depth)");
   render->add_option("--seed", settings.seed, "Random seed (same seed, same image)")
       ->capture_default_str();

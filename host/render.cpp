@@ -30,6 +30,8 @@ void validate(const RenderSettings& s) {
         "--samples: the sample indices must lie within 0:1048576");
   check(s.max_depth >= 0 && s.max_depth <= 1024, "--max-depth must be between 0 and 1024");
   check(s.rr_depth >= 0, "--rr-depth must be at least 0");
+  check(s.rr_threshold > 0.0f && s.rr_threshold <= 1.0f,
+        "--rr-threshold must be greater than 0 and at most 1");
   check(s.bvh_width == 0 || s.bvh_width == 2 || s.bvh_width == 8, "--bvh-width must be 2 or 8");
   check(std::isfinite(s.env_intensity) && s.env_intensity >= 0.0f,
         "--env-intensity must be a finite, non-negative number");
@@ -73,8 +75,9 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
   std::ostringstream k;
   k << "scene=" << hex64(scene.digest) << ";env=" << env << ";width=" << s.width
     << ";height=" << s.height << ";max_depth=" << s.max_depth << ";rr_depth=" << s.rr_depth
-    << ";seed=" << s.seed << ";background=" << num(s.background.x) << "," << num(s.background.y)
-    << "," << num(s.background.z) << ";env_intensity=" << num(s.env_intensity)
+    << ";rr_threshold=" << num(s.rr_threshold) << ";seed=" << s.seed
+    << ";background=" << num(s.background.x) << "," << num(s.background.y) << ","
+    << num(s.background.z) << ";env_intensity=" << num(s.env_intensity)
     << ";env_rotation=" << num(s.env_rotation) << ";strategy="
     << (s.strategy == Strategy::kMis   ? "mis"
         : s.strategy == Strategy::kNee ? "nee"

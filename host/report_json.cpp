@@ -54,6 +54,7 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
           {"wavepath:samples", std::to_string(s.sample_begin) + ":" + std::to_string(r.sample_end)},
           {"wavepath:max_depth", std::to_string(s.max_depth)},
           {"wavepath:rr_depth", std::to_string(s.rr_depth)},
+          {"wavepath:rr_threshold", num(s.rr_threshold)},
           {"wavepath:seed", std::to_string(s.seed)},
           {"wavepath:camera", std::to_string(s.camera)},
           {"wavepath:background",

@@ -243,6 +243,7 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   p.seed = settings_.seed;
   p.max_depth = static_cast<dev::uint>(settings_.max_depth);
   p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
+  p.rr_threshold = settings_.rr_threshold;
   return p;
 }
 

@@ -2,8 +2,8 @@
  * From: WP_QUEUE_SURFACE (paths that sampled a next ray in sample_bsdf).
  * To:   queue_out, the next bounce's ray queue, holding the survivors with their bounce count
  *       incremented. From bounce rr_depth on, a path survives with probability
- *       q = min(1, max throughput component x eta scale) and its throughput is divided by q
- *       (unbiased);
+ *       q = min(1, m / rr_threshold), m its largest throughput component times the eta scale, and
+ *       its throughput is divided by q (unbiased): a survivor of roulette carries rr_threshold;
  *       a path with zero throughput ends. */
 #include "stage.h"
 #include "surface.h"
@@ -20,7 +20,7 @@ WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot, 
   /* Survival looks at the throughput without the 1/eta^2 factors of refraction (pbrt-v4's
    * etaScale): inside glass they would otherwise end paths that are about to leave it, where
    * the factor is undone. */
-  const float m = max3(beta.xyz) * paths.radiance[slot].w;
+  const float m = max3(beta.xyz) * paths.radiance[slot].w / launch.rr_threshold;
   const uint bounce = paths.info[slot].y;
   if (bounce + 1u >= launch.rr_depth && m < 1.0f) {
     if (u >= m) return false;

@@ -374,6 +374,10 @@ TEST_F(LightTransport, RouletteOnAndOffAgree) {
   st.seed = 4;
   const wp::Rendered on = render(s, st);
   expect_agree(off, on, 4, "roulette off vs on");
+  st.rr_threshold = 1.0f;  // pbrt's rule, the most roulette a threshold allows
+  st.seed = 5;
+  const wp::Rendered strict = render(s, st);
+  expect_agree(off, strict, 4, "roulette off vs on at threshold 1");
 }
 
 // Irradiance at x (normal n) from a uniformly emitting polygon of radiance 1 (Lambert's formula):

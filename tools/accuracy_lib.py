@@ -66,6 +66,9 @@ def config_args(config):
             args += ["--no-rr"]
         elif key == "rr" and value.isdigit():
             args += ["--rr-depth", value]
+        elif key == "rrt":
+            float(value)  # ValueError when not a number; wavepath checks the range
+            args += ["--rr-threshold", value]
         elif key == "depth" and value.isdigit():
             args += ["--max-depth", value]
         elif key == "sampler" and value in ("independent", "sobol", "sobol-padded"):

@@ -172,6 +172,8 @@ typedef struct Launch {
   uint queue_out;     /* WP_QUEUE_* the stage appends to */
   uint wave_pixels; /* pixels in this wave: path slot i renders pixel pixel_offset + i % wave_pixels
                        at sample index sample + i / wave_pixels (stage.h, path_sample) */
+  float rr_threshold; /* roulette ends paths whose throughput is below this (roulette_compact.cl) */
+  uint pad[3];
 } Launch;
 
 WP_DEV_END
