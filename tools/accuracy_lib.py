@@ -21,6 +21,7 @@ v_x, against a reference r with variance image v_r, which is 0 for a closed form
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -66,9 +67,8 @@ def config_args(config):
             args += ["--no-rr"]
         elif key == "rr" and value.isdigit():
             args += ["--rr-depth", value]
-        elif key == "rrt":
-            float(value)  # ValueError when not a number; wavepath checks the range
-            args += ["--rr-threshold", value]
+        elif key == "rrt" and re.fullmatch(r"[0-9]*\.?[0-9]+", value):
+            args += ["--rr-threshold", value]  # wavepath checks the range
         elif key == "depth" and value.isdigit():
             args += ["--max-depth", value]
         elif key == "sampler" and value in ("independent", "sobol", "sobol-padded"):

@@ -173,7 +173,7 @@ typedef struct Launch {
   uint wave_pixels; /* pixels in this wave: path slot i renders pixel pixel_offset + i % wave_pixels
                        at sample index sample + i / wave_pixels (stage.h, path_sample) */
   float rr_threshold; /* roulette ends paths whose throughput is below this (roulette_compact.cl) */
-  uint pad[3];
+  uint pad[3];        /* to 64 bytes, a multiple of 16 on every device */
 } Launch;
 
 WP_DEV_END
