@@ -49,13 +49,14 @@ std::string program_cache_path(const std::string& dir, std::uint64_t key) {
 std::optional<std::vector<unsigned char>> program_cache_load(const std::string& dir,
                                                              std::uint64_t key) {
   if (dir.empty()) return std::nullopt;
-  std::FILE* f = std::fopen(program_cache_path(dir, key).c_str(), "rb");
+  const std::string path = program_cache_path(dir, key);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) return std::nullopt;
   std::optional<std::vector<unsigned char>> out;
   Header h{};
   // The size must be the file's (checked before anything is allocated), the checksum the bytes'.
   std::error_code ec;
-  const std::uintmax_t file_bytes = std::filesystem::file_size(program_cache_path(dir, key), ec);
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path, ec);
   if (!ec && std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, kMagic, 8) == 0 &&
       h.key == key && h.size > 0 && h.size <= kMaxBinary && file_bytes == sizeof h + h.size) {
     std::vector<unsigned char> bytes(h.size);

@@ -67,16 +67,19 @@ def main():
             secs = {s: [] for s in samplers}
             for seed in range(1, a.seeds + 1):
                 for s in samplers:
-                    img, _, info = accuracy_lib.render(a.wavepath, scene, extra, a.size, a.size,
-                                                       spp, seed, "mis+sampler=" + s)
-                    rel[s].append(accuracy_lib.compare(img, img, ref, ref_var)["rel_mse"])
+                    img, var, info = accuracy_lib.render(a.wavepath, scene, extra, a.size, a.size,
+                                                         spp, seed, "mis+sampler=" + s)
+                    rel[s].append(accuracy_lib.compare(img, var, ref, ref_var)["rel_mse"])
                     secs[s].append(info["seconds"])
             base = np.array(rel[samplers[0]])
             n = len(base)
+
+            def se(x):  # standard error of the mean over the seeds
+                return float(np.std(x, ddof=1) / np.sqrt(n)) if n > 1 else float("nan")
+
             for s in samplers:
                 r = np.array(rel[s])
                 q = r / base
-                se = lambda x: float(np.std(x, ddof=1) / np.sqrt(n)) if n > 1 else float("nan")
                 print("| %s | %d | %s | %.4g ± %.2g | %.4f ± %.4f | %.3f |"
                       % (os.path.basename(scene), spp, s, r.mean(), se(r), q.mean(), se(q),
                          statistics.median(secs[s])))
