@@ -87,7 +87,7 @@ struct EmbreeTree {
   ~EmbreeTree();
 };
 
-// Validates `input` and `options` (throws wp::Error naming the first problem) and runs Embree's
+// Validates `input` and `options` (throws bvh::Error naming the first problem) and runs Embree's
 // builder with at most options.width children per node. Leaves hold up to options.max_leaf_size
 // references; with options.spatial_splits a triangle may be referenced by several leaves. An input
 // without triangles (a valid glTF scene may have none) is not given to Embree: the tree has no

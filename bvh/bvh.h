@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,14 @@
 #include "../kernels/shared/bvh_layout.h"
 
 namespace wp::bvh {
+
+// What the BVH library throws: bad build input or options, an Embree failure, a traversal past
+// the stack. The library is below the host and knows nothing of its error type; main() prints any
+// std::exception in the same one line.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 struct BuildOptions {
   // The layout: 2 (BvhNode + IsectTri) or 8 (BvhNode8 + TriBlock4); anything else is an error.
@@ -63,7 +72,7 @@ struct Bvh {
   BuildStats stats;
 };
 
-// Builds the BVH. Throws wp::Error on failure (e.g. bad options, Embree error). An input without
+// Builds the BVH. Throws bvh::Error on failure (e.g. bad options, Embree error). An input without
 // triangles is valid: its BVH is a root alone whose children are all empty (binary: two leaves of
 // count 0 with lo > hi boxes; wide: 8 unused slots), which every ray misses, with bounds at the
 // origin.

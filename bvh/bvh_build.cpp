@@ -7,7 +7,6 @@
 #include <string>
 
 #include "build_tree.h"
-#include "host/error.h"
 
 namespace wp::bvh {
 namespace {

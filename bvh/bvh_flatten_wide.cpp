@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "build_tree.h"
-#include "host/error.h"
 
 namespace wp::bvh::detail {
 namespace {

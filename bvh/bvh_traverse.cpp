@@ -6,7 +6,6 @@
 // nearer (smaller tnear, tie: child 0) is visited next and the other pushed on the stack.
 #include <limits>
 
-#include "host/error.h"
 #include "traverse_common.h"
 
 namespace wp::bvh {

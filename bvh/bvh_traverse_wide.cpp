@@ -20,7 +20,6 @@
 // +INFINITY); visiting "node 0" then would restart at the root and never end.
 #include <cassert>
 
-#include "host/error.h"
 #include "traverse_common.h"
 
 namespace wp::bvh::detail {

@@ -2,8 +2,6 @@
 
 #include <cstring>
 
-#include "host/error.h"
-
 namespace wp::bvh {
 
 EmbreeScene::EmbreeScene(const glm::vec3* positions, std::size_t vertex_count,

@@ -15,7 +15,7 @@ namespace wp::bvh {
 class EmbreeScene {
  public:
   // RTC_BUILD_QUALITY_HIGH; `robust` adds RTC_SCENE_FLAG_ROBUST (watertight-ish, slower: for
-  // tests). Throws wp::Error if Embree fails.
+  // tests). Throws bvh::Error if Embree fails.
   EmbreeScene(const glm::vec3* positions, std::size_t vertex_count, const std::uint32_t* indices,
               std::size_t triangle_count, bool robust);
   ~EmbreeScene();

@@ -14,7 +14,7 @@
 // factor ("large leaf" mode), which still never makes a leaf larger than maxLeafSize. If even that
 // cannot fit (a subtree at depth d holding more than branching^(maxDepth - d) * maxLeafSize
 // references) it reports RTC_ERROR_UNKNOWN "depth limit reached" and rtcBuildBVH returns null,
-// which build() turns into wp::Error; it never returns an oversized leaf. So its trees have leaves
+// which build() turns into bvh::Error; it never returns an oversized leaf. So its trees have leaves
 // of at most maxLeafSize and inner nodes at depth <= maxDepth - 1. E.g. maxDepth 3, width 8,
 // maxLeafSize 8: 512 references build (depth 3), 513 fail. With WP_BVH8_MAX_DEPTH = 24 a failure
 // needs more than 8^8 * maxLeafSize references left at depth 16; with WP_BVH_MAX_DEPTH = 48
@@ -32,7 +32,6 @@
 #include <embree3/rtcore_builder.h>
 
 #include "build_tree.h"
-#include "host/error.h"
 
 namespace wp::bvh::detail {
 

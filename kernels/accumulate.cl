@@ -5,7 +5,7 @@
  *       saturated to [0, 2^64 - 1] (values from 2^32 on saturate). No sum overflows: a < 2^64
  *       and a^2 / 2^32 < 2^96, so 2^20 samples (the most a film holds) give S < 2^84 and
  *       Q < 2^116. Integer sums do not depend on the order of addition, so films of sample
- *       ranges rendered apart merge bit for bit (host/film.h). A sample that is NaN or infinite
+ *       ranges rendered apart merge bit for bit (host/film/film.h). A sample that is NaN or infinite
  *       is not added; it is counted in counters[WP_COUNTER_NONFINITE] (the renderer reports the
  *       count, the tests require 0) and weighs as 0 in the mean (S / 2^32 / spp).
  *

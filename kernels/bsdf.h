@@ -32,8 +32,8 @@
  * inside) have the relative index of refraction 1 / ior.
  *
  * Built with WP_FEATURE_GLOSSY 0 (a scene whose every scattering material has metallic 0,
- * specular factor 0 and no transmission: host/scene_features.cpp), f reduces to base / pi, and
- * evaluation and sampling are Lambert's alone: the same values, without the lobe machinery.
+ * specular factor 0 and no transmission: host/device/scene_features.cpp), f reduces to base / pi,
+ * and evaluation and sampling are Lambert's alone: the same values, without the lobe machinery.
  */
 #ifndef WP_BSDF_H
 #define WP_BSDF_H

@@ -1,6 +1,6 @@
 # The OpenCL C sources are embedded into the binary, so build/wavepath runs from anywhere; for
 # kernel work without a rebuild, WAVEPATH_KERNEL_DIR=<repo>/kernels makes the host read them from
-# disk instead (host/kernel_sources.cpp).
+# disk instead (host/device/kernel_sources.cpp).
 #
 # wp_embed_sources(TARGET t FUNCTION f ROOT dir FILES a.cl b.h ...)
 # Generates a C++ file defining `const std::vector<wp::EmbeddedFile>& wp::f()` with the text of

@@ -3,15 +3,14 @@
  * Without a map (env_width == 0, or a program built with WP_FEATURE_ENVIRONMENT=0) the
  * environment is the constant background radiance, sampled uniformly over the sphere.
  *
- * With a map of W x H = env_width x env_height texels (equirectangular; host/environment.h states
- * the convention), a world direction d is first turned into the map's frame by the inverse of the
- * rotation R about +Y (env_params.y, .z = cos R, sin R):
- *   m = (cos R d.x - sin R d.z, d.y, sin R d.x + cos R d.z),
- * then u = (atan2(m.x, -m.z) + pi) / (2 pi), v = theta / pi with theta = atan2(|m.xz|, m.y), and
- * the radiance is texel (floor(u W), floor(v H)) times env_params.x: nearest texel, piecewise
- * constant over (u, v) like the sampling density.
+ * With a map of W x H = env_width x env_height texels (equirectangular; host/lights/environment.h
+ * states the convention), a world direction d is first turned into the map's frame by the inverse
+ * of the rotation R about +Y (env_params.y, .z = cos R, sin R): m = (cos R d.x - sin R d.z, d.y,
+ * sin R d.x + cos R d.z), then u = (atan2(m.x, -m.z) + pi) / (2 pi), v = theta / pi with theta =
+ * atan2(|m.xz|, m.y), and the radiance is texel (floor(u W), floor(v H)) times env_params.x:
+ * nearest texel, piecewise constant over (u, v) like the sampling density.
  *
- * Sampling tables (host/environment.cpp fills them), float CDFs:
+ * Sampling tables (host/lights/environment.cpp fills them), float CDFs:
  *   env_marginal[0..H]: over rows; [0] = 0, [H] = 1, row y has probability
  *     P(y) = env_marginal[y+1] - env_marginal[y], proportional to the sum over the row of
  *     luminance x sin(theta at the row's centre), i.e. to luminance x solid angle.

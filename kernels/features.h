@@ -1,6 +1,6 @@
 /* What the program is specialised for. The host derives the WP_FEATURE_* set from the scene
- * (host/scene_features.cpp) and passes each as -D WP_FEATURE_X=0|1, so code for what a scene does
- * not use is not compiled at all; the render settings below are -D options too. Anything left
+ * (host/device/scene_features.cpp) and passes each as -D WP_FEATURE_X=0|1, so code for what a scene
+ * does not use is not compiled at all; the render settings below are -D options too. Anything left
  * undefined takes its default: every feature on (the all-features build), full MIS. */
 #ifndef WP_FEATURES_H
 #define WP_FEATURES_H

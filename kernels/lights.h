@@ -1,8 +1,8 @@
 /* Light sampling for next-event estimation, and the densities MIS needs for lights that BSDF
  * sampling found.
  *
- * Level 1: one light per shading point from the alias table (host/light_table.h documents the
- * uniform and power-proportional probabilities); with few lights the pick reuses the first
+ * Level 1: one light per shading point from the alias table (host/lights/light_table.h documents
+ * the uniform and power-proportional probabilities); with few lights the pick reuses the first
  * coordinate of the point's 2D number (sample_light). Then, per light:
  * - punctual (KHR_lights_punctual), delta distributions: a point/spot intensity is radiant
  *   intensity in W/sr, giving irradiance I / d^2 (spot: times the recommended cone falloff); a

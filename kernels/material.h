@@ -92,7 +92,8 @@ static inline void resolve_material(const SceneView* scene, __global const Mater
   s->roughness = q.y;
   s->ior = q.z;
   s->transmission = q.w;
-  s->specular = m->extra.z; /* KHR_materials_specular factor (host/device_scene.cpp packs it) */
+  s->specular =
+      m->extra.z; /* KHR_materials_specular factor (host/device/device_scene.cpp packs it) */
 #if WP_FEATURE_TEXTURES
   const int4 tex = m->textures0;
   if (tex.x >= 0) color *= texture_sample(scene, tex.x, uv).xyz;

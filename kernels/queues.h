@@ -6,9 +6,9 @@
  * with an atomic add per work-group (order is therefore arbitrary, and nothing may depend on it:
  * every result is a function of the slot's own state and its stateless random numbers). Consumers
  * are launched over an upper bound of the length and return past counters[q], so the host reads the
- * counters back only once per bounce (host/wavefront.cpp, run_bounce: before trace_shadow, which it
- * launches over the shadow queue's exact length). Every kernel moves a slot to at most one next
- * queue, or ends the path there.
+ * counters back only once per bounce (host/render/wavefront.cpp, run_bounce: before trace_shadow,
+ * which it launches over the shadow queue's exact length). Every kernel moves a slot to at most one
+ * next queue, or ends the path there.
  */
 #ifndef WP_QUEUES_H
 #define WP_QUEUES_H

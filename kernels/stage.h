@@ -9,7 +9,8 @@
 #include "queues.h"
 #include "scene.h"
 
-/* The arguments every stage kernel takes, in this order (host/stages.h launches them typed). */
+/* The arguments every stage kernel takes, in this order (host/render/stages.h launches them typed).
+ */
 #define WP_STAGE_PARAMS                                                                          \
   WP_SCENE_PARAMS, __global uchar *path_buf, PathLayout path_layout, __global uint *queue_slots, \
       __global uint *queue_counters, Launch launch

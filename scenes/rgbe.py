@@ -9,7 +9,7 @@ reading gives (m + 0.5) * 2^(e - 136) (stb_image, which wavepath uses, omits the
 relative rounding of the largest component is under 2^-7. Scanlines are written flat (not
 run-length encoded), which every reader accepts, so the bytes depend only on the pixels.
 
-The direction convention is host/environment.h's (glTF frame, +Y up): u runs with the azimuth
+The direction convention is host/lights/environment.h's (glTF frame, +Y up): u runs with the azimuth
 phi = atan2(d.x, -d.z) as u = (phi + pi) / (2 pi), so the map's centre column is seen looking down
 -Z; v = acos(d.y) / pi, row 0 at the top (+Y).
 """
@@ -19,7 +19,7 @@ import struct
 
 
 def direction(u, v):
-    """The unit direction at map coordinates (u, v), the inverse of host/environment.h's map."""
+    """The unit direction at map coordinates (u, v), the inverse of host/lights/environment.h's map."""
     phi = 2.0 * math.pi * u - math.pi
     theta = math.pi * v
     s = math.sin(theta)

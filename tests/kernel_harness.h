@@ -8,9 +8,9 @@
 
 #include <CL/opencl.hpp>
 
-#include "host/cl_runtime.h"
-#include "host/kernel_sources.h"
-#include "host/scene_buffers.h"
+#include "host/device/cl_runtime.h"
+#include "host/device/kernel_sources.h"
+#include "host/device/scene_buffers.h"
 
 namespace wp {
 // The test target's tests/kernels tree, embedded like the core kernels (tests/CMakeLists.txt).
@@ -52,7 +52,7 @@ class KernelHarness {
   }
 
   // Runs kernel `name` over `items` work-items with the given arguments and waits. A SceneBuffers
-  // argument stands for the WP_SCENE_PARAMS it sets (host/scene_buffers.h).
+  // argument stands for the WP_SCENE_PARAMS it sets (host/device/scene_buffers.h).
   template <class... Args>
   void run(const char* name, std::size_t items, const Args&... args) {
     cl::Kernel k(program_, name);

@@ -8,7 +8,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 namespace wp::test {
 

@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "host/cl_runtime.h"
-#include "host/film.h"
-#include "host/image_io.h"
-#include "host/render.h"
+#include "host/device/cl_runtime.h"
+#include "host/film/film.h"
+#include "host/film/image_io.h"
+#include "host/render/render.h"
 #include "tests/cli_run.h"
 #include "tests/scene_factory.h"
 #include "tests/test_assets.h"

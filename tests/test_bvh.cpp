@@ -12,7 +12,7 @@
 
 #include "bvh/build_tree.h"  // internal: the spatial-split clipper
 #include "bvh/bvh.h"
-#include "host/error.h"
+#include "host/util/error.h"
 #include "tests/bvh_test_util.h"
 
 namespace wp::bvh {

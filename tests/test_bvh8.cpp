@@ -15,7 +15,7 @@
 
 #include "bvh/build_tree.h"  // internal: flatten_wide on hand-made trees
 #include "bvh/bvh.h"
-#include "host/error.h"
+#include "host/util/error.h"
 #include "tests/bvh_test_util.h"
 
 namespace wp::bvh {

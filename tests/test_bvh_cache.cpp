@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh/bvh_cache.h"
+#include "host/accel/bvh_cache.h"
 #include "tests/bvh_test_util.h"
 
 // Every allocation of this test program goes through here, so that a test can tell the largest
@@ -261,7 +261,7 @@ TEST_F(BvhCache, TruncatedEntryIsAMiss) {
 }
 
 // build_cached's `accept` sees each fresh build before it is stored; one it refuses (render's
-// packed-size check, host/device_scene.h) leaves nothing in the cache.
+// packed-size check, host/device/device_scene.h) leaves nothing in the cache.
 TEST_F(BvhCache, RefusedBuildIsNotStored) {
   const Mesh mesh = soup(200, 9, 0.05f);
   const BuildOptions o;

@@ -16,7 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "host/image_io.h"
+#include "host/film/image_io.h"
 #include "tests/cli_run.h"
 #include "tests/test_assets.h"
 

@@ -1,14 +1,14 @@
-// Emissive textures in the light table (host/emission.h): triangles that emit nothing anywhere
-// are not lights, the others are weighted by the emission integrated over them. Host units; the
-// whole-render check that this changes no answer (NEE, BSDF sampling and MIS still agree) is
-// LightTransport.TexturedLampStrategiesAgree.
+// Emissive textures in the light table (host/lights/emission.h): triangles that emit nothing
+// anywhere are not lights, the others are weighted by the emission integrated over them. Host
+// units; the whole-render check that this changes no answer (NEE, BSDF sampling and MIS still
+// agree) is LightTransport.TexturedLampStrategiesAgree.
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-#include "host/emission.h"
-#include "host/gltf_loader.h"
-#include "host/light_table.h"
+#include "host/lights/emission.h"
+#include "host/scene/gltf_loader.h"
+#include "host/lights/light_table.h"
 #include "tests/scene_factory.h"
 #include "tests/test_assets.h"
 

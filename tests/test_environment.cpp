@@ -1,7 +1,7 @@
 // Environment maps: loading (.hdr, .exr and the refusals), the sampling tables, the direction
-// convention on the device (host/environment.h), and env_sample against env_pdf: chi-square on
-// equal-area sphere bins, pdf agreement per sample, normalisation, and an unbiased estimator of the
-// map's integral over the sphere.
+// convention on the device (host/lights/environment.h), and env_sample against env_pdf: chi-square
+// on equal-area sphere bins, pdf agreement per sample, normalisation, and an unbiased estimator of
+// the map's integral over the sphere.
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -23,9 +23,9 @@
 #include <stb_image_write.h>
 #include <gtest/gtest.h>
 
-#include "host/environment.h"
-#include "host/error.h"
-#include "host/light_table.h"
+#include "host/lights/environment.h"
+#include "host/util/error.h"
+#include "host/lights/light_table.h"
 #include "tests/chi2.h"
 #include "tests/kernel_harness.h"
 #include "tests/test_assets.h"
@@ -149,7 +149,7 @@ void write_exr(const std::string& path, int w, int h, const std::function<float(
             f(x, y, int(c));
   const std::size_t xs = channels.size() * sizeof(float), ys = xs * std::size_t(w);
   // OpenEXR's slice base: the pixels less the origin's offset, on the integer address (the
-  // pointer itself may lie outside any object; see host/environment.cpp, read_exr).
+  // pointer itself may lie outside any object; see host/lights/environment.cpp, read_exr).
   char* base = reinterpret_cast<char*>(reinterpret_cast<std::uintptr_t>(px.data()) -
                                        std::uintptr_t(std::intptr_t(origin.x)) * xs -
                                        std::uintptr_t(std::intptr_t(origin.y)) * ys);

@@ -1,4 +1,4 @@
-// The film in fixed point (host/film.h, kernels/accumulate.cl, kernels/shared/film.h): the
+// The film in fixed point (host/film/film.h, kernels/accumulate.cl, kernels/shared/film.h): the
 // arithmetic against 128-bit references, the accumulate kernel against the same references, the
 // .wpfilm file against truncation and corruption, and the promise it all exists for: renders of
 // sample ranges merged in any order give the single render's film and image bit for bit, whatever
@@ -20,12 +20,13 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
-#include "host/cl_runtime.h"
-#include "host/error.h"
-#include "host/film.h"
-#include "host/image_io.h"
-#include "host/render.h"
-#include "host/wavefront.h"
+#include "host/accel/bvh_input.h"
+#include "host/device/cl_runtime.h"
+#include "host/util/error.h"
+#include "host/film/film.h"
+#include "host/film/image_io.h"
+#include "host/render/render.h"
+#include "host/render/wavefront.h"
 #include "tests/cli_run.h"
 #include "tests/scene_factory.h"
 #include "tests/test_assets.h"

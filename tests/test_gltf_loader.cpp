@@ -16,9 +16,9 @@
 #include <gtest/gtest.h>
 #include <stb_image_write.h>
 
-#include "host/error.h"
-#include "host/gltf_loader.h"
-#include "host/gltf_primitive.h"
+#include "host/util/error.h"
+#include "host/scene/gltf_loader.h"
+#include "host/scene/gltf_primitive.h"
 #include "tests/test_assets.h"
 
 namespace {

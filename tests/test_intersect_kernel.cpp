@@ -17,9 +17,9 @@
 
 #include "bvh/bvh.h"
 #include "bvh/embree_scene.h"
-#include "host/cl_runtime.h"
-#include "host/gltf_loader.h"
-#include "host/wavefront.h"
+#include "host/device/cl_runtime.h"
+#include "host/scene/gltf_loader.h"
+#include "host/render/wavefront.h"
 #include "tests/scene_factory.h"
 #include "tests/test_assets.h"
 

@@ -16,13 +16,13 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "host/cl_runtime.h"
-#include "host/device_scene.h"
-#include "host/environment.h"
-#include "host/image_io.h"
-#include "host/light_table.h"
-#include "host/render.h"
-#include "host/scene_features.h"
+#include "host/device/cl_runtime.h"
+#include "host/device/device_scene.h"
+#include "host/lights/environment.h"
+#include "host/film/image_io.h"
+#include "host/lights/light_table.h"
+#include "host/render/render.h"
+#include "host/device/scene_features.h"
 #include "tests/scene_factory.h"
 
 namespace {
@@ -208,7 +208,7 @@ wp::RenderSettings agreement_settings() {
   return st;
 }
 
-// A small equirectangular sky (host/environment.h's convention): a gradient from 0.1 at the
+// A small equirectangular sky (host/lights/environment.h's convention): a gradient from 0.1 at the
 // horizon to 0.4 at the zenith, dark below, and a broad bright "sun" (15 degrees, radiance 6)
 // that BSDF sampling still finds often enough for its estimate to be close to Gaussian per block.
 std::shared_ptr<const wp::EnvironmentMap> test_sky() {
@@ -294,8 +294,8 @@ TEST_F(LightTransport, AlphaEmittersAgree) {
   }
 }
 
-// A lamp with an emissive texture that is black on its left half (host/emission.h): the lamp is
-// an 8 x 8 grid of quads, and the triangles on the black half are no lights at all. Light
+// A lamp with an emissive texture that is black on its left half (host/lights/emission.h): the lamp
+// is an 8 x 8 grid of quads, and the triangles on the black half are no lights at all. Light
 // sampling, BSDF sampling and MIS still agree (a triangle that is not in the light table shows
 // its emission to BSDF-sampled rays with weight 1).
 TEST_F(LightTransport, TexturedLampStrategiesAgree) {

@@ -1,5 +1,5 @@
-// Distributed rendering (host/distributed.h): `mpirun -np 3 wavepath render` on one machine gives
-// the single process's image and film bit for bit, also with more ranks than samples, and a
+// Distributed rendering (host/cli/distributed.h): `mpirun -np 3 wavepath render` on one machine
+// gives the single process's image and film bit for bit, also with more ranks than samples, and a
 // failure on any rank ends the whole job with a non-zero status instead of a hang. Skips only when
 // the build has no MPI or its launcher is gone (tools/setup.sh installs Open MPI).
 #include <unistd.h>
@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "host/film.h"
+#include "host/film/film.h"
 #include "tests/cli_run.h"
 #include "tests/test_assets.h"
 

@@ -1,5 +1,5 @@
-// The scene's split into device buffers (host/device_scene.h), checked before the BVH build: the
-// layout from counts agrees with pack_scene's, its BVH estimate never exceeds a real BVH (so no
+// The scene's split into device buffers (host/device/device_scene.h), checked before the BVH build:
+// the layout from counts agrees with pack_scene's, its BVH estimate never exceeds a real BVH (so no
 // scene that fits is refused), arrays never cross or exceed a buffer, scenes past the device's
 // buffers are refused before render() builds or caches a BVH, and a scene split over several
 // buffers renders exactly as in one. Counts stand in for scenes of tens of millions of
@@ -10,12 +10,13 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh/bvh_cache.h"
-#include "host/cl_runtime.h"
-#include "host/device_scene.h"
-#include "host/error.h"
-#include "host/light_table.h"
-#include "host/render.h"
+#include "host/accel/bvh_cache.h"
+#include "host/accel/bvh_input.h"
+#include "host/device/cl_runtime.h"
+#include "host/device/device_scene.h"
+#include "host/util/error.h"
+#include "host/lights/light_table.h"
+#include "host/render/render.h"
 #include "tests/scene_factory.h"
 
 namespace {

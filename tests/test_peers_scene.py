@@ -204,7 +204,7 @@ class Cameras(unittest.TestCase):
         self.assertClose(hi, (2.0, 2.0, 2.0))
 
     def test_framing_camera_is_wavepaths(self):
-        # host/gltf_loader.cpp: 45 degrees, from +Z and 15 degrees above, the bounding sphere
+        # host/scene/gltf_loader.cpp: 45 degrees, from +Z and 15 degrees above, the bounding sphere
         # (radius half the diagonal) fitting the tighter half-angle.
         lo, hi = (0.0, 0.0, 0.0), (2.0, 2.0, 2.0)
         e = math.radians(15.0)

@@ -1,6 +1,7 @@
-// The kernel program cache (host/program_cache.h, ClRuntime::build with a cache folder): a second
-// build comes from the cached binary and runs the same; a corrupted, truncated or refused entry is
-// a miss that builds from source and replaces it; the key changes with the source and options.
+// The kernel program cache (host/device/program_cache.h, ClRuntime::build with a cache folder): a
+// second build comes from the cached binary and runs the same; a corrupted, truncated or refused
+// entry is a miss that builds from source and replaces it; the key changes with the source and
+// options.
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "host/cl_runtime.h"
-#include "host/program_cache.h"
+#include "host/device/cl_runtime.h"
+#include "host/device/program_cache.h"
 
 namespace {
 

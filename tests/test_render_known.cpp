@@ -22,9 +22,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "host/cl_runtime.h"
-#include "host/device_scene.h"
-#include "host/render.h"
+#include "host/device/cl_runtime.h"
+#include "host/device/device_scene.h"
+#include "host/render/render.h"
 #include "tests/scene_factory.h"
 
 namespace {

@@ -26,7 +26,7 @@
 
 #include <gtest/gtest.h>
 
-#include "host/light_table.h"
+#include "host/lights/light_table.h"
 #include "kernels/shared/types.h"
 #include "tests/chi2.h"
 #include "tests/kernel_harness.h"

@@ -693,7 +693,7 @@ class FailureScenesTest(StructureMixin, unittest.TestCase):
     def test_environment_map(self):
         width, height, rows = rgbe.read_rgbe(os.path.join(FAILURE, "env_sun.hdr"))
         self.assertEqual((width, height), (mfs.ENV_W, mfs.ENV_H))
-        # host/environment.h's convention: the centre column looks down -Z, row 0 is +Y.
+        # host/lights/environment.h's convention: the centre column looks down -Z, row 0 is +Y.
         for got, want in zip(rgbe.direction(0.5, 0.5), (0.0, 0.0, -1.0)):
             self.assertAlmostEqual(got, want, places=12)
         self.assertAlmostEqual(rgbe.direction(0.5, 0.0)[1], 1.0, places=12)

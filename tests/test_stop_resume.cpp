@@ -1,7 +1,7 @@
 // Renders that stop early and go on: --time-limit, --noise-threshold, --checkpoint with SIGINT /
 // SIGTERM, --resume, and the progress lines, through the command line as users run it. Every
 // early stop is checked against an uninterrupted render of the samples it reports, bit for bit
-// (films are integer sums, host/film.h).
+// (films are integer sums, host/film/film.h).
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,9 +20,9 @@
 
 #include <gtest/gtest.h>
 
-#include "host/film.h"
-#include "host/image_io.h"
-#include "host/render.h"
+#include "host/film/film.h"
+#include "host/film/image_io.h"
+#include "host/render/render.h"
 #include "tests/cli_run.h"
 #include "tests/test_assets.h"
 

@@ -2,7 +2,7 @@
 // (kernels/material.h) on the OpenCL device, against host references written here from the glTF
 // 2.0 specification (its samplers follow OpenGL: texel centres at (i + 0.5) / size, wrap modes on
 // texel indices, NEAREST or bilinear LINEAR magnification) and the sRGB standard, over scenes
-// packed by host/device_scene.cpp exactly as renders are. The references compute in double.
+// packed by host/device/device_scene.cpp exactly as renders are. The references compute in double.
 //
 // Tolerances are float rounding bounds, derived where they are used (texture_bound()). Bilinear
 // filtering is 1-Lipschitz in the texel-space position per axis (texel values lie in [0, 1]), so
@@ -22,8 +22,8 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
-#include "host/device_scene.h"
-#include "host/light_table.h"
+#include "host/device/device_scene.h"
+#include "host/lights/light_table.h"
 #include "tests/kernel_harness.h"
 
 namespace {

@@ -2,7 +2,7 @@
 """GPU readiness without a GPU: compiles the wavefront program for NVIDIA and AMD GPUs offline.
 
 For each kernel variant (a set of build options), compiles the whole program (the 9 stage files
-in the host's order, one translation unit like host/wavefront.cpp's program_source()) with
+in the host's order, one translation unit like host/render/wavefront.cpp's program_source()) with
 clang's OpenCL C front end, warnings as errors (-Wall -Wextra -Werror):
   nvptx64  to PTX for sm_86 (the newest clang 14 knows), linked with libclc's builtins, then
            ptxas -arch=sm_90 -v: registers, spill stores/loads and stack frame of each kernel;
@@ -45,7 +45,7 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNELS = os.path.join(ROOT, "kernels")
-# host/stages.h kStageNames: the order program_source() concatenates them in.
+# host/render/stages.h kStageNames: the order program_source() concatenates them in.
 STAGES = ["generate_camera_rays", "intersect_closest", "shade_surface", "sample_lights",
           "trace_shadow", "sample_bsdf", "roulette_compact", "shade", "accumulate"]
 TRAVERSAL = ("intersect_closest", "trace_shadow")

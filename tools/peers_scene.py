@@ -331,7 +331,7 @@ def bounds(path):
 
 
 def framing_camera(lo, hi, aspect):
-    """wavepath's camera for a file without one (host/gltf_loader.cpp, framing_camera): 45 degree
+    """wavepath's camera for a file without one (host/scene/gltf_loader.cpp, framing_camera): 45 degree
     vertical field of view, looking at the centre of the bounds along -Z from the +Z side, 15
     degrees from above, at the distance where the bounding sphere fits the view at `aspect`
     (width / height). As scene["camera"] of load(), with "aspect": aspect."""

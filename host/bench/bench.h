@@ -9,9 +9,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "host/cl_runtime.h"
-#include "host/error.h"
-#include "host/wavefront.h"
+#include "host/device/cl_runtime.h"
+#include "host/util/error.h"
+#include "host/render/wavefront.h"
 
 namespace wp::bench {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <thread>
 
-#include "host/error.h"
+#include "host/util/error.h"
 
 namespace wp::bench {
 

@@ -8,7 +8,7 @@
 
 #include "bvh/embree_scene.h"
 
-#include "host/scene.h"
+#include "host/scene/scene.h"
 
 namespace wp::bench {
 

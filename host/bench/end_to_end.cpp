@@ -24,8 +24,8 @@
 
 #include "host/bench/bench.h"
 #include "host/bench/scene_bench.h"
-#include "host/gltf_loader.h"
-#include "host/render.h"
+#include "host/scene/gltf_loader.h"
+#include "host/render/render.h"
 
 extern char** environ;
 
@@ -217,7 +217,8 @@ int run_startup_probe(int argc, char** argv) {
     const Scene scene = load_gltf(argv[2]);
     RenderSettings settings = bench_settings(false);
     settings.spp = 1;
-    settings.kernel_cache_dir = argv[6];  // as `wavepath render` keeps it (host/program_cache.h)
+    settings.kernel_cache_dir =
+        argv[6];  // as `wavepath render` keeps it (host/device/program_cache.h)
     const double before_render = since(start);
     const Rendered r = render(runtime, scene, settings);
     std::printf("build_seconds=%.9f first_pass_seconds=%.9f\n", r.report.kernel_build_seconds,

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 
-#include "host/device_scene.h"
-#include "host/gltf_loader.h"
-#include "host/render.h"
+#include "host/accel/bvh_input.h"
+#include "host/device/device_scene.h"
+#include "host/scene/gltf_loader.h"
+#include "host/render/render.h"
 
 namespace wp::bench {
 

@@ -17,9 +17,9 @@
 #include "bvh/bvh.h"
 #include "host/bench/bench.h"
 #include "host/bench/embree_ref.h"
-#include "host/scene.h"
-#include "host/stages.h"
-#include "host/wavefront.h"
+#include "host/scene/scene.h"
+#include "host/render/stages.h"
+#include "host/render/wavefront.h"
 
 namespace wp::bench {
 

@@ -3,7 +3,7 @@
  * Shared headers (everything under kernels/shared/) declare plain-old-data structs that cross the
  * host/device boundary. They use only the vector types float4/int4/uint4 (16-byte aligned in both
  * languages, never float3) and 32-bit scalars, and pad explicitly, so the layout is identical on
- * both sides. The host checks sizes and offsets with static_assert (host/device_types.cpp).
+ * both sides. The host checks sizes and offsets with static_assert (host/device/device_types.cpp).
  *
  * In C++ the declarations live in namespace wp::dev, opened and closed by WP_DEV_BEGIN/WP_DEV_END.
  */

@@ -1,5 +1,5 @@
 /* The film in fixed point: the layout shared by the accumulate kernel, the host's Film
- * (host/film.h) and the .wpfilm file, which stores the device buffer word for word.
+ * (host/film/film.h) and the .wpfilm file, which stores the device buffer word for word.
  *
  * A sample's radiance v (per channel; finite, NaN/Inf are dropped and counted before) becomes the
  * integer a = round(v * 2^32), saturated to [0, 2^64 - 1] (convert_ulong_sat_rte): 32 fraction
@@ -12,9 +12,9 @@
  * S < 2^84 and Q < 2^116: no sum can overflow 128 bits, whatever the values (saturated ones
  * included); Q would first overflow after 2^32 samples.
  *
- * Layout: WP_FILM_WORDS_PER_PIXEL 64-bit words per pixel (WP_FILM_WORDS(aov) with AOVs, below), pixels row by row from the top; each
- * 128-bit value is two words, the low word first: S of R, G, B (WP_FILM_SUM(c)), then Q of R, G, B
- * (WP_FILM_SQUARES(c)). 96 bytes per pixel.
+ * Layout: WP_FILM_WORDS_PER_PIXEL 64-bit words per pixel (WP_FILM_WORDS(aov) with AOVs, below),
+ * pixels row by row from the top; each 128-bit value is two words, the low word first: S of R, G, B
+ * (WP_FILM_SUM(c)), then Q of R, G, B (WP_FILM_SQUARES(c)). 96 bytes per pixel.
  */
 #ifndef WP_SHARED_FILM_H
 #define WP_SHARED_FILM_H
@@ -33,6 +33,7 @@
 #define WP_FILM_ALBEDO(c) (12u + 2u * (c))
 #define WP_FILM_NORMAL(c) (18u + 2u * (c))
 #define WP_FILM_DEPTH 24u
-#define WP_FILM_WORDS(aov) ((aov) ? WP_FILM_WORDS_PER_PIXEL + WP_FILM_AOV_WORDS : WP_FILM_WORDS_PER_PIXEL)
+#define WP_FILM_WORDS(aov) \
+  ((aov) ? WP_FILM_WORDS_PER_PIXEL + WP_FILM_AOV_WORDS : WP_FILM_WORDS_PER_PIXEL)
 
 #endif /* WP_SHARED_FILM_H */

@@ -111,11 +111,11 @@ typedef struct Camera {
 } Camera;
 
 /* The scene's arrays lie in up to WP_SCENE_BUFFERS device buffers, each no larger than the
- * device's largest allocation (host/device_scene.h). Which buffer holds an array is fixed when the
- * program is built: WP_SCENE_BUFFER_MAP (kernels/scene.h), WP_SCENE_BUFFER_BITS per array in
- * SceneDesc's order, so every scene pointer is one kernel argument plus an offset (a buffer index
- * known only at run time made every kernel 12% slower on PoCL). The offset of each array in its
- * buffer is in SceneDesc, in units of WP_SCENE_ALIGN bytes: a uint reaches 256 GiB. */
+ * device's largest allocation (host/device/device_scene.h). Which buffer holds an array is fixed
+ * when the program is built: WP_SCENE_BUFFER_MAP (kernels/scene.h), WP_SCENE_BUFFER_BITS per array
+ * in SceneDesc's order, so every scene pointer is one kernel argument plus an offset (a buffer
+ * index known only at run time made every kernel 12% slower on PoCL). The offset of each array in
+ * its buffer is in SceneDesc, in units of WP_SCENE_ALIGN bytes: a uint reaches 256 GiB. */
 #define WP_SCENE_BUFFERS 8
 #define WP_SCENE_BUFFER_BITS 3
 #define WP_SCENE_ALIGN 64

@@ -1,8 +1,8 @@
 // libFuzzer target: wp::load_environment on arbitrary bytes. Inputs starting with the OpenEXR
 // magic (76 2f 31 01) are loaded as .exr (OpenEXR's reader, not instrumented here, so it is
 // reached but not explored), all others as .hdr (the project's own bounded RGBE reader, the main
-// target). The contract (host/environment.h): any input ends in a map or in one wp::Error. Any
-// other exception, a crash, a sanitizer report, a hang or a map whose tables disagree with its
+// target). The contract (host/lights/environment.h): any input ends in a map or in one wp::Error.
+// Any other exception, a crash, a sanitizer report, a hang or a map whose tables disagree with its
 // size or are not CDFs (the kernels would sample out of bounds) is a finding.
 #include <cmath>
 #include <cstddef>
@@ -12,8 +12,8 @@
 #include <cstring>
 #include <string>
 
-#include "host/environment.h"
-#include "host/error.h"
+#include "host/lights/environment.h"
+#include "host/util/error.h"
 #include "tests/fuzz/fuzz_file.h"
 
 namespace {

@@ -1,7 +1,7 @@
 // libFuzzer target: wp::load_gltf on arbitrary bytes. Inputs starting with the binary magic "glTF"
-// are loaded as .glb, all others as .gltf (JSON). The loader's contract (host/gltf_loader.h): any
-// input ends in a Scene or in one wp::Error. Any other exception, a crash, a sanitizer report, a
-// hang or a Scene whose arrays disagree (which the BVH build and the device upload would read out
+// are loaded as .glb, all others as .gltf (JSON). The loader's contract (host/scene/gltf_loader.h):
+// any input ends in a Scene or in one wp::Error. Any other exception, a crash, a sanitizer report,
+// a hang or a Scene whose arrays disagree (which the BVH build and the device upload would read out
 // of bounds) is a finding.
 #include <cstddef>
 #include <cstdio>
@@ -10,8 +10,8 @@
 #include <cstring>
 #include <string>
 
-#include "host/error.h"
-#include "host/gltf_loader.h"
+#include "host/util/error.h"
+#include "host/scene/gltf_loader.h"
 #include "tests/fuzz/fuzz_file.h"
 
 namespace {
@@ -30,7 +30,7 @@ void check_texture_slot(int slot, std::size_t textures, std::size_t material, co
                    std::to_string(slot) + " of " + std::to_string(textures) + " textures");
 }
 
-// The cross-references host/scene.h promises, everything downstream indexes with.
+// The cross-references host/scene/scene.h promises, everything downstream indexes with.
 void check_scene(const wp::Scene& s) {
   const std::size_t v = s.positions.size();
   check_same_size(s.normals.size(), v, "normals", false);

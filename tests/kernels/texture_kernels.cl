@@ -1,6 +1,6 @@
 /* Test kernels for tests/test_textures.cpp: texture sampling (textures.h), material alpha
  * (alpha.h) and the resolved surface (material.h), each over a scene packed by
- * host/device_scene.cpp and queried item by item. */
+ * host/device/device_scene.cpp and queried item by item. */
 #include "alpha.h"
 #include "material.h"
 #include "textures.h"

@@ -1,0 +1,357 @@
+#include "host/device/device_scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "host/util/error.h"
+
+namespace wp {
+
+namespace {
+
+dev::float4 f4(glm::vec3 v, float w = 0.0f) {
+  return {v.x, v.y, v.z, w};
+}
+dev::float4 f4(glm::vec4 v) {
+  return {v.x, v.y, v.z, v.w};
+}
+
+// Every array starts at a 64-byte boundary of its buffer; an empty one still takes 16 bytes (a
+// buffer is never empty). pack_scene and scene_layout both place arrays with these.
+std::uint64_t aligned(std::uint64_t end) {
+  return (end + WP_SCENE_ALIGN - 1) & ~std::uint64_t(WP_SCENE_ALIGN - 1);
+}
+std::uint64_t padded(std::uint64_t size) {
+  return std::max<std::uint64_t>(size, 16);
+}
+
+std::string too_many_texels() {
+  return "scene too large for the device: more than 2^32 texels in its images";
+}
+
+// "2.50 GiB", "3.2 MiB" or "900 bytes".
+std::string human_bytes(std::uint64_t bytes) {
+  char text[48];
+  if (bytes >= (1ull << 30))
+    std::snprintf(text, sizeof(text), "%.2f GiB", double(bytes) / double(1ull << 30));
+  else if (bytes >= (1ull << 20))
+    std::snprintf(text, sizeof(text), "%.1f MiB", double(bytes) / double(1ull << 20));
+  else
+    std::snprintf(text, sizeof(text), "%llu bytes", static_cast<unsigned long long>(bytes));
+  return text;
+}
+
+// The arrays pack_scene packs, in its order (SceneDesc's); the environment's three come last and
+// only with a map.
+constexpr std::array<const char*, 18> kArrayNames = {"BVH node",
+                                                     "BVH triangle",
+                                                     "triangle vertex",
+                                                     "position",
+                                                     "normal",
+                                                     "tangent",
+                                                     "uv",
+                                                     "colour",
+                                                     "material",
+                                                     "texture",
+                                                     "image",
+                                                     "texel",
+                                                     "light",
+                                                     "light alias",
+                                                     "triangle light",
+                                                     "environment texel",
+                                                     "environment marginal",
+                                                     "environment conditional"};
+
+dev::Material device_material(const Material& m) {
+  dev::Material d{};
+  d.base_color = f4(m.base_color);
+  d.emission = f4(m.emission, m.alpha_cutoff);
+  d.params = {m.metallic, m.roughness, m.ior, m.transmission};
+  d.volume =
+      f4(m.attenuation_color, m.attenuation_distance > 0.0f ? m.attenuation_distance : INFINITY);
+  d.extra = {m.normal_scale, m.thickness, m.specular, 0.0f};
+  dev::uint flags = 0;
+  if (m.double_sided) flags |= WP_MAT_DOUBLE_SIDED;
+  if (m.alpha_mode == AlphaMode::kMask) flags |= WP_MAT_ALPHA_MASK;
+  if (m.alpha_mode == AlphaMode::kBlend) flags |= WP_MAT_ALPHA_BLEND;
+  if (m.unlit) flags |= WP_MAT_UNLIT;
+  if (m.thickness > 0.0f) flags |= WP_MAT_VOLUME;
+  d.flags = {flags, 0u, 0u, 0u};
+  d.textures0 = {m.base_color_texture, m.metallic_roughness_texture, m.normal_texture,
+                 m.emissive_texture};
+  d.textures1 = {m.transmission_texture, -1, -1, -1};
+  return d;
+}
+
+dev::uint wrap_bits(Wrap w) {
+  return w == Wrap::kRepeat        ? WP_WRAP_REPEAT
+         : w == Wrap::kClampToEdge ? WP_WRAP_CLAMP
+                                   : WP_WRAP_MIRROR;
+}
+
+dev::TextureRef device_texture(const TextureRef& t) {
+  dev::TextureRef d{};
+  d.transform_u = f4(t.row_u);
+  d.transform_v = f4(t.row_v);
+  dev::uint bits = wrap_bits(t.wrap_s) | (wrap_bits(t.wrap_t) << 8);
+  if (t.nearest) bits |= WP_TEX_NEAREST;
+  if (t.srgb) bits |= WP_TEX_SRGB;
+  d.meta = {static_cast<dev::uint>(t.image), bits, static_cast<dev::uint>(t.texcoord), 0u};
+  return d;
+}
+
+// All images' texels in one array, RGBA8 with R in the lowest byte.
+void pack_images(const Scene& scene, std::vector<dev::TextureImage>& images,
+                 std::vector<dev::uint>& texels) {
+  for (const Image& img : scene.images) {
+    const std::size_t n = std::size_t(img.width) * std::size_t(img.height);
+    images.push_back({static_cast<dev::uint>(texels.size()), static_cast<dev::uint>(img.width),
+                      static_cast<dev::uint>(img.height), 0u});
+    for (std::size_t i = 0; i < n; ++i)
+      texels.push_back(dev::uint(img.rgba[4 * i]) | dev::uint(img.rgba[4 * i + 1]) << 8 |
+                       dev::uint(img.rgba[4 * i + 2]) << 16 | dev::uint(img.rgba[4 * i + 3]) << 24);
+  }
+}
+
+std::uint64_t ceil_div(std::uint64_t a, std::uint64_t b) {
+  return (a + b - 1) / b;
+}
+
+}  // namespace
+
+dev::Camera device_camera(const Camera& c, int width, int height) {
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const glm::vec3 forward = glm::normalize(c.forward);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
+  const glm::vec3 up = glm::cross(right, forward);
+  float half_w, half_h;
+  if (c.type == CameraType::kPerspective) {
+    half_h = std::tan(0.5f * c.yfov);
+    half_w = half_h * aspect;
+  } else {
+    half_h = c.ymag;
+    half_w = c.ymag * aspect;
+  }
+  dev::Camera d{};
+  d.position = f4(c.position, c.znear);
+  d.forward = f4(forward);
+  d.right = f4(right * half_w);
+  d.up = f4(up * half_h);
+  d.meta = {c.type == CameraType::kPerspective ? WP_CAMERA_PERSPECTIVE : WP_CAMERA_ORTHOGRAPHIC, 0u,
+            0u, 0u};
+  return d;
+}
+
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
+                       std::uint64_t max_buffer) {
+  const std::size_t tris = scene.triangle_count();
+  const std::size_t verts = scene.positions.size();
+  std::vector<dev::Material> materials;
+  for (const Material& m : scene.materials) materials.push_back(device_material(m));
+  std::vector<dev::TextureRef> textures;
+  for (const TextureRef& t : scene.textures) textures.push_back(device_texture(t));
+  std::vector<dev::TextureImage> images;
+  std::vector<dev::uint> texels;
+  pack_images(scene, images, texels);
+  if (texels.size() > 0xffffffffu) throw Error(too_many_texels());
+
+  PackedScene p;
+  dev::SceneDesc& d = p.desc;
+  // The arrays in kArrayNames' order, each with the SceneDesc field of its offset and what writes
+  // it in place: a copy of an array that exists, or, for the per-triangle and per-vertex arrays,
+  // their conversion straight into the buffer (no intermediate copy of gigabytes for tens of
+  // millions of triangles). The BVH is in the layout the program was built for (WP_BVH_WIDTH):
+  // the same two fields either way.
+  struct Array {
+    std::uint64_t bytes;
+    dev::uint* offset;
+    std::function<void(unsigned char*)> write;
+  };
+  const auto copy = [](const auto& items, dev::uint& offset) {
+    const std::uint64_t bytes = items.size() * sizeof(items[0]);
+    const void* data = items.data();
+    return Array{bytes, &offset, [data, bytes](unsigned char* to) {
+                   if (bytes) std::memcpy(to, data, bytes);
+                 }};
+  };
+  // `count` elements of type T, element i made by make(i).
+  const auto convert = [](std::size_t count, dev::uint& offset, auto make) {
+    using T = decltype(make(std::size_t{0}));
+    return Array{count * sizeof(T), &offset, [count, make](unsigned char* to) {
+                   T* out = reinterpret_cast<T*>(to);
+                   for (std::size_t i = 0; i < count; ++i) out[i] = make(i);
+                 }};
+  };
+  std::vector<Array> arrays = {
+      bvh.width == 8 ? copy(bvh.nodes8, d.bvh_nodes) : copy(bvh.nodes, d.bvh_nodes),
+      bvh.width == 8 ? copy(bvh.blocks, d.isect_tris) : copy(bvh.triangles, d.isect_tris),
+      convert(tris, d.tri_vertices,
+              [&](std::size_t i) {
+                return dev::uint4{scene.indices[3 * i], scene.indices[3 * i + 1],
+                                  scene.indices[3 * i + 2], scene.triangle_material[i]};
+              }),
+      convert(verts, d.positions, [&](std::size_t i) { return f4(scene.positions[i]); }),
+      convert(verts, d.normals, [&](std::size_t i) { return f4(scene.normals[i]); }),
+      convert(verts, d.tangents,
+              [&](std::size_t i) {
+                return i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
+              }),
+      convert(verts, d.uvs,
+              [&](std::size_t i) {
+                const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
+                const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
+                return dev::float4{uv0.x, uv0.y, uv1.x, uv1.y};
+              }),
+      convert(verts, d.colors,
+              [&](std::size_t i) {
+                return i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
+              }),
+      copy(materials, d.materials),
+      copy(textures, d.textures),
+      copy(images, d.images),
+      copy(texels, d.texels),
+      copy(x.lights->lights, d.lights),
+      copy(x.lights->alias, d.light_alias),
+      copy(x.lights->tri_light, d.tri_light)};
+  if (x.env) {
+    arrays.push_back(copy(x.env->texels, d.env_texels));
+    arrays.push_back(copy(x.env->marginal, d.env_marginal));
+    arrays.push_back(copy(x.env->conditional, d.env_conditional));
+  }
+  std::vector<std::uint64_t> sizes;
+  for (const Array& a : arrays) sizes.push_back(a.bytes);
+  const SceneLayout layout = plan_scene_layout(sizes, max_buffer);
+  p.buffers.resize(layout.buffer_bytes.size());
+  for (std::size_t i = 0; i < p.buffers.size(); ++i) p.buffers[i].resize(layout.buffer_bytes[i]);
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    const SceneLayout::Place place = layout.places[i];
+    arrays[i].write(p.buffers[place.buffer].data() + place.offset);
+    *arrays[i].offset = static_cast<dev::uint>(place.offset / WP_SCENE_ALIGN);
+  }
+  p.buffer_map = layout.buffer_map();
+
+  d.camera = x.camera;
+  d.background = f4(x.background);
+  const float rotation = x.env_rotation_degrees * 3.14159265358979f / 180.0f;
+  d.env_params = {x.env_intensity, std::cos(rotation), std::sin(rotation), 0.0f};
+  d.light_count = static_cast<dev::uint>(x.lights->lights.size());
+  d.env_light = x.lights->env_light;
+  d.triangle_count = static_cast<dev::uint>(tris);
+  if (x.env) {
+    d.env_width = static_cast<dev::uint>(x.env->width);
+    d.env_height = static_cast<dev::uint>(x.env->height);
+  }
+  return p;
+}
+
+std::uint64_t SceneLayout::buffer_map() const {
+  std::uint64_t map = 0;
+  for (std::size_t i = 0; i < places.size(); ++i)
+    map |= std::uint64_t(places[i].buffer) << (WP_SCENE_BUFFER_BITS * i);
+  return map;
+}
+
+std::uint64_t SceneLayout::total_bytes() const {
+  std::uint64_t total = 0;
+  for (const std::uint64_t b : buffer_bytes) total += b;
+  return total;
+}
+
+SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint64_t max_buffer) {
+  max_buffer = std::min(max_buffer, kSceneBufferReach);
+  std::uint64_t total = 0;
+  for (const std::uint64_t size : sizes) total += padded(size);
+  SceneLayout layout;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    const std::uint64_t size = padded(sizes[i]);
+    if (size > max_buffer)
+      throw Error("scene too large for the device: its " + std::string(kArrayNames.at(i)) +
+                  " array needs " + human_bytes(size) +
+                  ", more than the device's largest buffer (" + human_bytes(max_buffer) + ")");
+    if (layout.buffer_bytes.empty() || aligned(layout.buffer_bytes.back()) + size > max_buffer)
+      layout.buffer_bytes.push_back(0);
+    if (layout.buffer_bytes.size() > WP_SCENE_BUFFERS)
+      throw Error("scene too large for the device: " + human_bytes(total) + " does not fit in " +
+                  std::to_string(WP_SCENE_BUFFERS) + " buffers of at most " +
+                  human_bytes(max_buffer) + " (the device's largest buffer)");
+    const std::uint64_t offset = aligned(layout.buffer_bytes.back());
+    layout.places.push_back({static_cast<int>(layout.buffer_bytes.size() - 1), offset});
+    layout.buffer_bytes.back() = offset + size;
+  }
+  return layout;
+}
+
+SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env) {
+  SceneCounts c;
+  c.triangles = scene.triangle_count();
+  c.vertices = scene.positions.size();
+  c.materials = scene.materials.size();
+  c.textures = scene.textures.size();
+  c.images = scene.images.size();
+  for (const Image& img : scene.images)
+    c.texels += std::uint64_t(std::max(img.width, 0)) * std::uint64_t(std::max(img.height, 0));
+  c.punctual_lights = scene.lights.size();
+  if (env) {
+    c.env_texels = env->texels.size();
+    c.env_marginal = env->marginal.size();
+    c.env_conditional = env->conditional.size();
+  }
+  return c;
+}
+
+BvhBytes bvh_bytes(const bvh::Bvh& b) {
+  if (b.width == WP_BVH8_WIDTH)
+    return {b.nodes8.size() * sizeof(dev::BvhNode8), b.blocks.size() * sizeof(dev::TriBlock4)};
+  return {b.nodes.size() * sizeof(dev::BvhNode), b.triangles.size() * sizeof(dev::IsectTri)};
+}
+
+BvhBytes min_bvh_bytes(std::uint64_t triangles, int width) {
+  // n inner nodes of at most `fan_out` children have fan_out * n child slots, which hold the n - 1
+  // non-root nodes and every leaf: n >= (leaves - 1) / (fan_out - 1).
+  const auto min_nodes = [](std::uint64_t leaves, std::uint64_t fan_out) {
+    return std::max<std::uint64_t>(1, ceil_div(leaves > 0 ? leaves - 1 : 0, fan_out - 1));
+  };
+  if (width == WP_BVH8_WIDTH) {
+    const std::uint64_t blocks = ceil_div(triangles, 4);
+    const std::uint64_t leaves = ceil_div(blocks, WP_BVH8_MAX_LEAF_BLOCKS);
+    return {min_nodes(leaves, WP_BVH8_WIDTH) * sizeof(dev::BvhNode8),
+            blocks * sizeof(dev::TriBlock4)};
+  }
+  const std::uint64_t leaves = ceil_div(triangles, WP_BVH_MAX_LEAF_SIZE);
+  return {min_nodes(leaves, 2) * sizeof(dev::BvhNode), triangles * sizeof(dev::IsectTri)};
+}
+
+SceneLayout scene_layout(const SceneCounts& c, const BvhBytes& bvh, std::uint64_t max_buffer) {
+  if (c.texels > 0xffffffffu) throw Error(too_many_texels());
+  // pack_scene's arrays in its order.
+  std::vector<std::uint64_t> sizes = {bvh.nodes,
+                                      bvh.primitives,
+                                      c.triangles * sizeof(dev::uint4),  // tri_vertices
+                                      c.vertices * sizeof(dev::float4),  // positions
+                                      c.vertices * sizeof(dev::float4),  // normals
+                                      c.vertices * sizeof(dev::float4),  // tangents
+                                      c.vertices * sizeof(dev::float4),  // uvs
+                                      c.vertices * sizeof(dev::float4),  // colors
+                                      c.materials * sizeof(dev::Material),
+                                      c.textures * sizeof(dev::TextureRef),
+                                      c.images * sizeof(dev::TextureImage),
+                                      c.texels * sizeof(dev::uint),
+                                      c.punctual_lights * sizeof(dev::Light),
+                                      c.punctual_lights * sizeof(dev::LightAlias),
+                                      c.triangles * sizeof(std::uint32_t)};  // tri_light
+  if (c.env_texels || c.env_marginal || c.env_conditional) {
+    sizes.push_back(c.env_texels * sizeof(glm::vec4));
+    sizes.push_back(c.env_marginal * sizeof(float));
+    sizes.push_back(c.env_conditional * sizeof(float));
+  }
+  return plan_scene_layout(sizes, max_buffer);
+}
+
+}  // namespace wp

@@ -1,0 +1,120 @@
+// The scene as the device sees it: its arrays packed into up to WP_SCENE_BUFFERS byte buffers, each
+// no larger than the device's largest allocation, at 64-byte aligned offsets. A SceneDesc
+// (kernels/shared/types.h) records each array's offset, the program's WP_SCENE_BUFFER_MAP its
+// buffer. Plus the device camera.
+#pragma once
+
+#include <cstdint>
+#include <new>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "bvh/bvh.h"
+#include "host/lights/environment.h"
+#include "host/lights/light_table.h"
+#include "host/scene/scene.h"
+#include "kernels/shared/types.h"
+
+namespace wp {
+
+// Bytes at a page boundary, so that a CPU device can use them in place (CL_MEM_USE_HOST_PTR:
+// PoCL then makes no copy of a scene that may be gigabytes; scene_buffers.h).
+template <class T>
+struct PageAligned {
+  using value_type = T;
+  static constexpr std::align_val_t kAlign{4096};
+  PageAligned() = default;
+  template <class U>
+  PageAligned(const PageAligned<U>&) {}
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlign)); }
+  void deallocate(T* p, std::size_t) { ::operator delete(p, kAlign); }
+  template <class U>
+  bool operator==(const PageAligned<U>&) const {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const PageAligned<U>&) const {
+    return false;
+  }
+};
+using SceneBytes = std::vector<unsigned char, PageAligned<unsigned char>>;
+
+struct PackedScene {
+  std::vector<SceneBytes> buffers;  // 1 to WP_SCENE_BUFFERS, uploaded as they are
+  dev::SceneDesc desc{};
+  std::uint64_t buffer_map = 0;  // the program's WP_SCENE_BUFFER_MAP (SceneLayout::buffer_map)
+};
+
+// The most bytes one scene buffer may hold: a uint of 64-byte units reaches 256 GiB.
+inline constexpr std::uint64_t kSceneBufferReach = std::uint64_t(1) << 38;
+
+// The device camera for an image of width x height. Perspective: image-plane half extents
+// tan(yfov/2) * aspect and tan(yfov/2) with aspect = width / height (glTF's convention: yfov is
+// vertical, the image's aspect wins over the camera's aspectRatio). Orthographic: half extents
+// ymag * aspect and ymag (likewise, the image's aspect decides the horizontal extent).
+dev::Camera device_camera(const Camera& camera, int width, int height);
+
+// Everything about the render that is not in Scene: the camera, what escaped rays see, the lights.
+struct SceneExtras {
+  dev::Camera camera{};
+  glm::vec3 background{0.0f};           // constant radiance without a map
+  const EnvironmentMap* env = nullptr;  // may be null
+  float env_intensity = 1.0f;
+  float env_rotation_degrees = 0.0f;
+  const LightTable* lights = nullptr;  // required
+};
+
+// Packs the scene into buffers of at most `max_buffer` bytes (the device's CL_DEVICE_MAX_MEM_ALLOC
+// _SIZE; capped at kSceneBufferReach). Throws plan_scene_layout's wp::Error when it does not fit.
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& extras,
+                       std::uint64_t max_buffer = kSceneBufferReach);
+
+// Where the arrays go. Each array, in pack_scene's order, starts at the next 64-byte boundary of
+// the last buffer, or at the start of a new buffer when it would end past max_buffer there.
+struct SceneLayout {
+  struct Place {
+    int buffer = 0;
+    std::uint64_t offset = 0;  // bytes, a multiple of WP_SCENE_ALIGN
+  };
+  std::vector<Place> places;                // per array
+  std::vector<std::uint64_t> buffer_bytes;  // per buffer: where its last array ends (padded)
+  std::uint64_t total_bytes() const;
+  // Each array's buffer in WP_SCENE_BUFFER_BITS bits, the first array's lowest (0: one buffer).
+  std::uint64_t buffer_map() const;
+};
+// The layout of arrays of `sizes` bytes. Throws wp::Error("scene too large for the device: ...")
+// naming the array when one alone exceeds max_buffer, or the total when more than
+// WP_SCENE_BUFFERS buffers would be needed. Larger sizes never need fewer buffers (each array's
+// buffer and end only move forward), so a layout of lower bounds that fails means the real fails.
+SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint64_t max_buffer);
+
+// The size check of pack_scene, ahead of it: a scene too large to pack fails before its BVH is
+// built (minutes, and an entry in the BVH cache, for tens of millions of triangles).
+//
+// The element counts of what pack_scene packs, known before the BVH and the light table exist.
+struct SceneCounts {
+  std::uint64_t triangles = 0, vertices = 0;
+  std::uint64_t materials = 0, textures = 0, images = 0, texels = 0;
+  std::uint64_t punctual_lights = 0;  // a lower bound on the light table's lights
+  std::uint64_t env_texels = 0, env_marginal = 0, env_conditional = 0;  // no map: 0
+};
+SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env);  // env may be null
+
+// The bytes of the BVH's two packed arrays (nodes, then triangles or blocks).
+struct BvhBytes {
+  std::uint64_t nodes = 0, primitives = 0;
+};
+BvhBytes bvh_bytes(const bvh::Bvh& bvh);
+// At most the bytes of any BVH of layout `width` (2 or 8) over `triangles` triangles: every
+// triangle referenced, leaves of at most WP_BVH_MAX_LEAF_SIZE triangles or WP_BVH8_MAX_LEAF_BLOCKS
+// blocks of 4, inner nodes of 2 (or up to 8) children.
+BvhBytes min_bvh_bytes(std::uint64_t triangles, int width);
+
+// pack_scene's layout for these counts and BVH sizes. A lower bound when they are lower bounds:
+// min_bvh_bytes before the build, and always the lights (the light table's emissive triangles and
+// environment light are not counted), so no scene that fits is refused. Throws like
+// plan_scene_layout, and when the images hold 2^32 texels or more (uint texel offsets).
+SceneLayout scene_layout(const SceneCounts& counts, const BvhBytes& bvh, std::uint64_t max_buffer);
+
+}  // namespace wp

@@ -1,0 +1,132 @@
+#include "host/lights/light_table.h"
+
+#include <cmath>
+#include <numeric>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "host/lights/emission.h"
+#include "host/util/error.h"
+
+namespace wp {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double luminance(glm::vec3 c) {
+  return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+}
+dev::float4 f4(glm::vec3 v, float w = 0.0f) {
+  return {v.x, v.y, v.z, w};
+}
+
+dev::Light punctual(const PunctualLight& l) {
+  dev::Light d{};
+  d.position = f4(l.position, l.range);
+  d.direction = f4(glm::normalize(l.direction));
+  d.intensity = f4(l.intensity);
+  // KHR_lights_punctual's recommended spot falloff: saturate(cd * scale + offset)^2.
+  const float cos_outer = std::cos(l.outer_cone), cos_inner = std::cos(l.inner_cone);
+  const float scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
+  d.spot = {scale, -cos_outer * scale, 0.0f, 0.0f};
+  d.meta.x = l.type == LightType::kPoint  ? WP_LIGHT_POINT
+             : l.type == LightType::kSpot ? WP_LIGHT_SPOT
+                                          : WP_LIGHT_DIRECTIONAL;
+  return d;
+}
+
+double punctual_power(const PunctualLight& l, double radius) {
+  const double i = luminance(l.intensity);
+  switch (l.type) {
+    case LightType::kPoint:
+      return 4.0 * kPi * i;
+    case LightType::kSpot:
+      return 2.0 * kPi * (1.0 - std::cos(0.5 * (l.inner_cone + l.outer_cone))) * i;
+    default:
+      return kPi * radius * radius * i;
+  }
+}
+
+}  // namespace
+
+std::vector<dev::LightAlias> build_alias_table(const std::vector<double>& weights) {
+  const std::size_t n = weights.size();
+  const double total = std::accumulate(weights.begin(), weights.end(), 0.0);
+  if (n == 0 || !(total > 0.0) || !std::isfinite(total))
+    throw Error("light selection: no light with positive finite power");
+  std::vector<dev::LightAlias> table(n);
+  std::vector<double> scaled(n);
+  std::vector<std::size_t> small, large;
+  for (std::size_t i = 0; i < n; ++i) {
+    table[i].pmf = static_cast<float>(weights[i] / total);
+    table[i].alias = static_cast<dev::uint>(i);
+    scaled[i] = weights[i] / total * static_cast<double>(n);
+    (scaled[i] < 1.0 ? small : large).push_back(i);
+  }
+  while (!small.empty() && !large.empty()) {
+    const std::size_t s = small.back(), l = large.back();
+    small.pop_back();
+    table[s].prob = static_cast<float>(scaled[s]);
+    table[s].alias = static_cast<dev::uint>(l);
+    scaled[l] -= 1.0 - scaled[s];
+    if (scaled[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  for (std::size_t i : small) table[i].prob = 1.0f;  // rounding leftovers
+  for (std::size_t i : large) table[i].prob = 1.0f;
+  return table;
+}
+
+LightTable build_light_table(const Scene& scene, const EnvironmentMap* env, glm::vec3 background,
+                             float env_intensity, LightSelect select) {
+  LightTable t;
+  std::vector<double> power;
+  // The scene's bounding radius; 0 for inverted bounds (a scene without triangles built in code).
+  const glm::vec3 extent = glm::max(scene.bounds_hi - scene.bounds_lo, glm::vec3(0.0f));
+  const double radius = 0.5 * glm::length(extent);
+  for (const PunctualLight& l : scene.lights) {
+    t.lights.push_back(punctual(l));
+    power.push_back(punctual_power(l, radius));
+  }
+  t.tri_light.assign(scene.triangle_count(), WP_NO_LIGHT);
+  for (std::size_t i = 0; i < scene.triangle_count(); ++i) {
+    const Material& m = scene.materials[scene.triangle_material[i]];
+    const TriangleEmission e = triangle_emission(scene, i);
+    if (e.zero()) continue;  // black everywhere (an emissive texture's dark part): not a light
+    const glm::vec3 a = scene.positions[scene.indices[3 * i]];
+    const glm::vec3 b = scene.positions[scene.indices[3 * i + 1]];
+    const glm::vec3 c = scene.positions[scene.indices[3 * i + 2]];
+    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+    if (!(area > 0.0)) continue;  // a degenerate triangle emits nothing
+    dev::Light d{};
+    d.meta.x = WP_LIGHT_TRIANGLE;
+    d.meta.y = static_cast<dev::uint>(i);
+    t.tri_light[i] = static_cast<std::uint32_t>(t.lights.size());
+    t.lights.push_back(d);
+    // The integrated emission; a triangle whose sampled mean is 0 but whose peak is not (a lit
+    // spot between the grid points) keeps a small chance of being chosen.
+    const double l = std::max(luminance(e.mean), 1e-3 * e.peak);
+    power.push_back(kPi * area * l * (m.double_sided ? 2.0 : 1.0));
+    ++t.emissive_triangles;
+  }
+  const double env_luminance = env ? env->mean_luminance * env_intensity : luminance(background);
+  if (env_luminance > 0.0) {
+    dev::Light d{};
+    d.meta.x = WP_LIGHT_ENVIRONMENT;
+    t.env_light = static_cast<std::uint32_t>(t.lights.size());
+    t.lights.push_back(d);
+    power.push_back(4.0 * kPi * kPi * radius * radius * env_luminance);
+  }
+  if (t.lights.empty()) return t;
+  if (select == LightSelect::kUniform) power.assign(power.size(), 1.0);
+  for (double& p : power)  // a light NEE could reach must keep a chance of being picked
+    if (!(p > 0.0)) p = 1e-12;
+  t.alias = build_alias_table(power);
+  return t;
+}
+
+}  // namespace wp

@@ -1,0 +1,29 @@
+#include "host/render/path_state.h"
+
+#include "host/util/error.h"
+
+namespace wp {
+
+PathStateLayout path_state_layout(std::size_t capacity, bool aov) {
+  using namespace dev;
+  PathStateLayout s;
+  std::size_t offset = 0;
+  const auto place = [&](std::size_t element_size) {
+    const std::size_t at = offset;
+    offset = (offset + element_size * capacity + 63) & ~std::size_t(63);
+    s.bytes_per_path += element_size;
+    if (offset > 0xffffffffu)
+      throw Error("path state too large for 32-bit offsets; use a smaller wave");
+    return static_cast<uint>(at);
+  };
+#define WP_PATH_FIELD(type, name, description) s.layout.name = place(sizeof(type));
+#define WP_PATH_AOV_FIELD(type, name, description) s.layout.name = place(aov ? sizeof(type) : 0);
+#include "kernels/shared/path_state.def"
+#undef WP_PATH_AOV_FIELD
+#undef WP_PATH_FIELD
+  s.layout.capacity = static_cast<uint>(capacity);
+  s.bytes = offset;
+  return s;
+}
+
+}  // namespace wp

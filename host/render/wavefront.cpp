@@ -1,0 +1,383 @@
+#include "host/render/wavefront.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "host/device/device_scene.h"
+#include "host/util/error.h"
+#include "host/util/fnv1a.h"
+#include "host/scene/gltf_loader.h"
+#include "host/device/kernel_sources.h"
+
+namespace wp {
+
+const char* sampler_name(Sampler s) {
+  switch (s) {
+    case Sampler::kSobol:
+      return "sobol";
+    case Sampler::kSobolPadded:
+      return "sobol-padded";
+    case Sampler::kIndependent:
+      break;
+  }
+  return "independent";
+}
+
+namespace {
+
+// The one place where program build options are assembled: the scene's features and the
+// settings that are compile-time constants of the kernels.
+std::string program_options(const SceneFeatures& features, const RenderSettings& s, int bvh_width,
+                            std::size_t group_size, bool prefetch) {
+  std::string o = "-cl-std=CL1.2 -D WP_BVH_WIDTH=" + std::to_string(bvh_width);
+  o += " -D WP_GROUP_SIZE=" + std::to_string(group_size);
+  if (prefetch) o += " -D WP_PREFETCH=1";
+  for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
+  o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
+  o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
+  // kernels/features.h's WP_SAMPLER_INDEPENDENT, _SOBOL and _SOBOL_PADDED.
+  o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kIndependent ? "0"
+                                         : s.sampler == Sampler::kSobol     ? "1"
+                                                                            : "2");
+  if (s.aov) o += " -D WP_AOV=1";
+  return o;
+}
+
+std::string program_source() {
+  std::vector<std::string> files;
+  for (const char* name : kStageNames) files.push_back(std::string(name) + ".cl");
+  return KernelSources().expand(files);
+}
+
+const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
+  const float aspect = static_cast<float>(s.width) / static_cast<float>(s.height);
+  if (s.camera >= 0) {
+    if (static_cast<std::size_t>(s.camera) >= scene.cameras.size())
+      throw Error("--camera " + std::to_string(s.camera) + ": the scene has " +
+                  std::to_string(scene.cameras.size()) + " camera(s)");
+    return device_camera(scene.cameras[s.camera], s.width, s.height);
+  }
+  if (!scene.cameras.empty()) return device_camera(scene.cameras.front(), s.width, s.height);
+  return device_camera(framing_camera(scene, aspect), s.width, s.height);
+}
+
+}  // namespace
+
+std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings) {
+  if (settings.scene_buffer_bytes) return settings.scene_buffer_bytes;
+  return device.max_alloc ? device.max_alloc : kSceneBufferReach;
+}
+
+Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+                     const RenderSettings& settings)
+    : rt_(runtime), settings_(settings) {
+  const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
+  // A wave holds up to 2^20 pixels of one sample; a smaller image gets several samples per wave,
+  // up to about kMultiSamplePaths paths (or the --wave-size asked for), so that its passes are
+  // not mostly kernel launches on a few rays (the last bounces).
+  wave_size_ = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
+  const std::size_t multi = settings.wave_size ? settings.wave_size : kMultiSamplePaths;
+  samples_per_wave_ = std::max<std::size_t>(1, multi / wave_size_);
+  // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
+  // of it) and compiles every kernel again for each new one, seconds each time.
+  local_size_ = settings.local_size ? settings.local_size : 64;
+  const EnvironmentMap* env = settings.environment.get();
+  features_ =
+      settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
+  // Cache hints in the stages that read path state through a queue (kernels/features.h,
+  // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
+  // instruction and every address space is one.
+  const DeviceEntry& device = rt_.device();
+  const bool prefetch =
+      settings.prefetch && !device.gpu && device.platform_name == "Portable Computing Language";
+  options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
+  path_state_ = path_state_layout(wave_paths(), settings.aov);
+  lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
+                              settings.light_select);
+
+  SceneExtras extras;
+  extras.camera = pick_camera(scene, settings);
+  extras.background = settings.background;
+  extras.env = env;
+  extras.env_intensity = settings.env_intensity;
+  extras.env_rotation_degrees = settings.env_rotation;
+  extras.lights = &lights_;
+  const cl::Context& ctx = rt_.context();
+  try {
+    // On a CPU device the kernels read the packed scene in place, which therefore stays here; a
+    // GPU gets its own copy, and the host's goes at the end of this block.
+    const bool in_place = !rt_.device().gpu;
+    PackedScene packed = pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings));
+    scene_ = upload_scene(ctx, packed, in_place);
+    scene_buffer_count_ = static_cast<int>(packed.buffers.size());
+    for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
+    // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
+    // buffer leaves the options as they were.
+    if (packed.buffer_map) {
+      char map[64];
+      std::snprintf(map, sizeof(map), " -D WP_SCENE_BUFFER_MAP=0x%llxul",
+                    static_cast<unsigned long long>(packed.buffer_map));
+      options_ += map;
+    }
+    if (in_place) packed_ = std::move(packed.buffers);
+    path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
+    queue_slots_ =
+        cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_paths() * sizeof(dev::uint));
+    counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
+    const std::size_t film_words = pixels * WP_FILM_WORDS(settings.aov);
+    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
+    // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
+    // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every
+    // host write, sized to that write, so a fill (stored one pattern at a time) or a partial write
+    // leaves the entire buffer "uninitialised" to its --uninitialized check. The counters are 20
+    // bytes; the film's host zeros are as large as the copy film() reads back, and made once.
+    const std::vector<dev::uint> zero_counters(WP_COUNTER_COUNT, 0u);
+    rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, zero_counters.size() * sizeof(dev::uint),
+                                   zero_counters.data());
+    const std::vector<std::uint64_t> zero_film(film_words, 0);
+    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, zero_film.size() * sizeof(std::uint64_t),
+                                   zero_film.data());
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "allocating device memory on " + rt_.device().name);
+  }
+
+  const auto build_start = std::chrono::steady_clock::now();
+  const std::string source = program_source();
+  source_digest_ = fnv1a64(source.data(), source.size());
+  program_ = rt_.build(source, options_, settings.kernel_cache_dir);
+  kernel_cached_ = rt_.cached_build();
+  try {
+    for (int i = 0; i < kStageCount; ++i) {
+      cl::Kernel& k = kernels_.emplace_back(program_, kStageNames[i]);
+      cl_uint arg = set_scene_args(k, 0, scene_);
+      k.setArg(arg++, path_buf_);
+      k.setArg(arg++, path_state_.layout);
+      k.setArg(arg++, queue_slots_);
+      k.setArg(arg++, counters_);
+      launch_arg_ = arg++;
+      if (static_cast<Stage>(i) == Stage::kAccumulate) k.setArg(arg++, film_);
+    }
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "setting the kernels' arguments on " + rt_.device().name);
+  }
+  prime_kernels();
+  try {
+    for (const auto size : program_.getInfo<CL_PROGRAM_BINARY_SIZES>()) binary_bytes_ += size;
+  } catch (const cl::Error&) {
+    binary_bytes_ = 0;  // not every implementation reports binaries
+  }
+  build_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
+}
+
+// Some implementations (PoCL) compile a kernel only at its first launch, for the work-group size
+// of that launch. One empty launch of each stage here makes that cost part of the build (where
+// kernel_build_seconds reports it) instead of the first sample pass.
+void Wavefront::prime_kernels() {
+  dev::Launch p = launch_params(0, 0, 0);  // no paths: every work-item returns at once
+  p.wave_pixels = 1;  // never divided by here (nothing gets past its early return), but not by 0
+  p.queue_in = WP_QUEUE_RAY_A;
+  p.queue_out = WP_QUEUE_RAY_B;
+  try {
+    for (int i = 0; i < kStageCount; ++i) {
+      // Only the stages this pipeline runs: PoCL compiles a kernel at its first launch, and the
+      // other pipeline's kernels would add to the cold build for nothing.
+      const Stage s = static_cast<Stage>(i);
+      const bool split_only = s == Stage::kShadeSurface || s == Stage::kSampleLights ||
+                              s == Stage::kSampleBsdf || s == Stage::kRouletteCompact;
+      if (settings_.fused ? split_only : s == Stage::kShade) continue;
+      launch(s, static_cast<std::uint32_t>(local_size_), p);
+    }
+    rt_.queue().finish();
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "preparing the kernels on " + rt_.device().name);
+  }
+  pending_events_.clear();
+}
+
+cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
+  if (items == 0) return cl::Event();
+  const std::size_t local = local_size_;
+  const std::size_t global = local ? (items + local - 1) / local * local : items;
+  cl::Kernel& kernel = kernels_[static_cast<int>(stage)];
+  cl::Event event;
+  try {
+    kernel.setArg(launch_arg_, params);
+    rt_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
+                                     local ? cl::NDRange(local) : cl::NullRange, nullptr, &event);
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, std::string("launching ") + stage_name(stage));
+  }
+  if (settings_.profile) pending_events_.emplace_back(stage, event);
+  return event;
+}
+
+std::uint32_t Wavefront::read_counter(std::uint32_t index) {
+  dev::uint value = 0;
+  rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, index * sizeof(dev::uint), sizeof(value),
+                                &value);
+  return value;
+}
+
+void Wavefront::write_queue(dev::uint queue, const std::vector<dev::uint>& slots) {
+  if (slots.size() > wave_paths()) throw Error("write_queue: more slots than the wave holds");
+  std::vector<dev::uint> counters(WP_QUEUE_COUNT, 0u);
+  counters[queue] = static_cast<dev::uint>(slots.size());
+  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
+                                 counters.data());
+  if (!slots.empty())
+    rt_.queue().enqueueWriteBuffer(queue_slots_, CL_TRUE, queue * wave_paths() * sizeof(dev::uint),
+                                   slots.size() * sizeof(dev::uint), slots.data());
+}
+
+dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_pixel,
+                                     std::uint32_t count, std::uint32_t samples) const {
+  dev::Launch p{};
+  p.width = static_cast<dev::uint>(settings_.width);
+  p.height = static_cast<dev::uint>(settings_.height);
+  p.pixel_offset = first_pixel;
+  p.wave_pixels = count;
+  p.path_count = count * samples;
+  p.sample = sample;
+  p.seed = settings_.seed;
+  p.max_depth = static_cast<dev::uint>(settings_.max_depth);
+  p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
+  p.rr_threshold = settings_.rr_threshold;
+  return p;
+}
+
+// One wave of paths through all bounces: the algorithm, one named call per stage.
+void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                         std::uint32_t samples) {
+  dev::Launch p = start_wave(sample, first_pixel, count, samples);
+  for (std::uint32_t rays = p.path_count; rays > 0;) {
+    rays_traced_ += rays;
+    rays = run_bounce(p, rays);
+  }
+  launch(Stage::kAccumulate, count, p);
+}
+
+dev::Launch Wavefront::start_wave(std::uint32_t sample, std::uint32_t first_pixel,
+                                  std::uint32_t count, std::uint32_t samples) {
+  dev::Launch p = launch_params(sample, first_pixel, count, samples);
+  p.queue_out = WP_QUEUE_RAY_A;
+  launch(Stage::kGenerateCameraRays, p.path_count, p);
+  p.queue_in = WP_QUEUE_RAY_A;
+  p.queue_out = WP_QUEUE_RAY_B;
+  return p;
+}
+
+std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
+  // Empty the surface, shadow and output queues. One write of all queue counters from offset 0,
+  // with queue_in's rewritten to the `rays` it already holds, rather than fills of the three: any
+  // partial host write makes Oclgrind 21.10 treat the whole counter buffer as uninitialised (see
+  // the constructor). The nonfinite counter after them is not written: it persists (so Oclgrind
+  // would call it uninitialised, were count_nonfinite ever reached; it must not be).
+  std::array<dev::uint, WP_QUEUE_COUNT> counters{};
+  counters[p.queue_in] = rays;
+  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
+                                 counters.data());
+  launch(Stage::kIntersectClosest, rays, p);
+  if (settings_.fused) {
+    launch(Stage::kShade, rays, p);  // the queues it fills hold at most `rays` slots
+  } else {
+    launch(Stage::kShadeSurface, rays, p);
+    launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
+    launch(Stage::kSampleBsdf, rays, p);
+    launch(Stage::kRouletteCompact, rays, p);
+  }
+  // The bounce's one read-back: the shadow queue's length and the next bounce's ray count. Shadow
+  // rays are traced last, over exactly their count: launched over `rays`, as the other stages
+  // are, the work-groups past the queue's end (most of them where few rays find a surface or few
+  // lights are visible) cost more than the rays did (README, "Shadow rays launched over their
+  // count"). trace_shadow reads nothing the stages before it change after sample_lights (the
+  // bounce for its random numbers travels with the ray).
+  std::array<dev::uint, WP_QUEUE_COUNT> counts{};
+  rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),
+                                counts.data());
+  launch(Stage::kTraceShadow, counts[WP_QUEUE_SHADOW], p);
+  const std::uint32_t next = counts[p.queue_out];
+  std::swap(p.queue_in, p.queue_out);
+  return next;
+}
+
+Wavefront::Snapshot Wavefront::snapshot() {
+  Snapshot s;
+  s.paths.resize(path_state_.bytes);
+  s.slots.resize(WP_QUEUE_COUNT * wave_paths());
+  s.counters.resize(WP_COUNTER_COUNT);
+  auto& q = rt_.queue();
+  q.enqueueReadBuffer(path_buf_, CL_FALSE, 0, s.paths.size(), s.paths.data());
+  q.enqueueReadBuffer(queue_slots_, CL_FALSE, 0, s.slots.size() * sizeof(dev::uint),
+                      s.slots.data());
+  q.enqueueReadBuffer(counters_, CL_TRUE, 0, s.counters.size() * sizeof(dev::uint),
+                      s.counters.data());
+  return s;
+}
+
+void Wavefront::restore(const Snapshot& s) {
+  auto& q = rt_.queue();
+  q.enqueueWriteBuffer(path_buf_, CL_FALSE, 0, s.paths.size(), s.paths.data());
+  q.enqueueWriteBuffer(queue_slots_, CL_FALSE, 0, s.slots.size() * sizeof(dev::uint),
+                       s.slots.data());
+  q.enqueueWriteBuffer(counters_, CL_TRUE, 0, s.counters.size() * sizeof(dev::uint),
+                       s.counters.data());
+}
+
+void Wavefront::render_pass(std::uint32_t sample, std::uint32_t samples) {
+  if (samples < 1 || samples > samples_per_wave_)
+    throw Error("render_pass: the samples of a pass must fit one wave");
+  const std::uint32_t pixels = static_cast<std::uint32_t>(settings_.width * settings_.height);
+  try {
+    for (std::uint32_t first = 0; first < pixels; first += static_cast<std::uint32_t>(wave_size_))
+      run_wave(sample, first,
+               std::min<std::uint32_t>(static_cast<std::uint32_t>(wave_size_), pixels - first),
+               samples);
+    rt_.queue().finish();
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "rendering on " + rt_.device().name);
+  }
+  if (settings_.profile) collect_profile();
+}
+
+void Wavefront::collect_profile() {
+  for (auto& [stage, event] : pending_events_) {
+    const auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+    const auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+    times_.seconds[static_cast<int>(stage)] += static_cast<double>(end - start) * 1e-9;
+    times_.launches[static_cast<int>(stage)] += 1;
+  }
+  pending_events_.clear();
+}
+
+Film Wavefront::film(FilmInfo info) {
+  if (info.width != settings_.width || info.height != settings_.height)
+    throw Error("Wavefront::film: the film's size is not the render's");
+  Film film(std::move(info));
+  auto& words = film.words();
+  try {
+    rt_.queue().enqueueReadBuffer(film_, CL_TRUE, 0, words.size() * sizeof(std::uint64_t),
+                                  words.data());
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "reading the film back from " + rt_.device().name);
+  }
+  return film;
+}
+
+void Wavefront::load_film(const Film& film) {
+  if (film.info().width != settings_.width || film.info().height != settings_.height)
+    throw Error("Wavefront::load_film: the film's size is not the render's");
+  try {  // the whole buffer in one write, as in the constructor (Oclgrind's initialisation state)
+    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, film.words().size() * sizeof(std::uint64_t),
+                                   film.words().data());
+  } catch (const cl::Error& e) {
+    rethrow_cl(e, "writing the film to " + rt_.device().name);
+  }
+}
+
+std::uint64_t Wavefront::nonfinite_samples() {
+  return read_counter(WP_COUNTER_NONFINITE);
+}
+
+}  // namespace wp

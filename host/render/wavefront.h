@@ -1,0 +1,233 @@
+// The wavefront path tracer on one OpenCL device: the scene and the path state in device buffers,
+// the program specialised to the scene's features, and the render loop over the stage kernels.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "bvh/bvh.h"
+#include "host/device/cl_runtime.h"
+#include "host/lights/environment.h"
+#include "host/film/film.h"
+#include "host/lights/light_table.h"
+#include "host/render/path_state.h"
+#include "host/scene/scene.h"
+#include "host/device/scene_buffers.h"
+#include "host/device/scene_features.h"
+#include "host/render/stages.h"
+#include "kernels/shared/types.h"
+
+namespace wp {
+
+enum class Strategy { kMis, kNee, kBsdf };
+enum class MisHeuristic { kPower, kBalance };
+// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points, the light and BSDF pairs of two
+// bounces chained to one sample order (kSobol) or every group in an order of its own
+// (kSobolPadded), or independent hashes.
+enum class Sampler { kSobol, kIndependent, kSobolPadded };
+// The --sampler name of a pattern ("sobol", "independent", "sobol-padded").
+const char* sampler_name(Sampler s);
+
+struct RenderSettings {
+  int width = 640;
+  int height = 480;
+  int spp = 64;  // samples per pixel
+  // The render takes sample indices [sample_begin, sample_begin + spp), within [0, 2^20): a
+  // part of a longer render, whose films merge exactly (host/film/film.h).
+  int sample_begin = 0;
+  // Record albedo, normal and depth per sample too (AOVs, kernels/shared/film.h; FilmImages).
+  bool aov = false;
+  int max_depth = 12;  // scattering events per path at most
+  // Russian roulette from this many scattering events on (>= max_depth: off); 5 from the study in
+  // docs/accuracy.md ("Russian roulette"): less variance per sample than 3, the same work or less
+  // for a given error except in closed diffuse rooms (-11% there, +28% on a glossy floor).
+  int rr_depth = 5;
+  // Roulette's throughput threshold: from rr_depth on, a path whose throughput (largest channel,
+  // kernels/roulette_compact.cl) m is below it survives with probability m / rr_threshold and
+  // then carries rr_threshold; at or above it, always. 1 is pbrt's rule (survival probability =
+  // throughput); 0.5 from the study in docs/accuracy.md ("the survival threshold"): 0.99-1.17
+  // times the efficiency of 1 on five scenes (most in closed rooms), next to no change on open
+  // scenes.
+  float rr_threshold = 0.5f;
+  std::uint32_t seed = 0;      // the image is a pure function of (scene, settings, seed)
+  glm::vec3 background{0.0f};  // radiance of escaped rays when there is no environment map
+  std::shared_ptr<const EnvironmentMap> environment;  // optional
+  float env_intensity = 1.0f;                         // scales the map
+  float env_rotation = 0.0f;                          // degrees about +Y
+  Strategy strategy = Strategy::kMis;
+  MisHeuristic mis_heuristic = MisHeuristic::kPower;
+  LightSelect light_select = LightSelect::kPower;
+  Sampler sampler = Sampler::kSobol;
+  int camera = -1;            // index into Scene::cameras; -1: the first, or a framing camera
+  bool all_features = false;  // build every kernel feature regardless of the scene
+  // Path slots per wave; 0: min(pixels, 2^20), or for an image of fewer than kMultiSamplePaths
+  // pixels, as many whole samples of it as fit in kMultiSamplePaths. A size above the pixel count
+  // also holds several samples (its quotient by the pixel count).
+  std::size_t wave_size = 0;
+  std::size_t local_size = 0;  // work-group size; 0: 64
+  bool profile = false;        // time every kernel launch with profiling events
+  // One fused kernel per bounce for everything at a hit (kernels/shade.cl), or the split stages
+  // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit.
+  // Fused by default: on PoCL it measured 10% faster on the Cornell box (README, "Fused shading").
+  bool fused = true;
+  // Cache hints for the path state ahead in each queue, on PoCL's CPU devices (kernels/features.h,
+  // WP_PREFETCH); elsewhere nothing. The same image either way.
+  bool prefetch = true;
+  int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
+  // Where built kernel programs are cached (host/device/program_cache.h; the command line passes
+  // bvh::cache_dir()); empty: nothing is cached.
+  std::string kernel_cache_dir;
+  // Most bytes in one scene buffer (device_scene.h); 0: the device's largest allocation. Smaller
+  // values split even small scenes over several buffers (tests).
+  std::uint64_t scene_buffer_bytes = 0;
+};
+
+// The paths a wave of a small image holds by default (RenderSettings::wave_size): fewer waves
+// per sample, so fewer launches that trace only the last bounces' few rays. On the Lambertian
+// Cornell box, 128 x 128 x 256 spp on PoCL, waves of 2^14 paths took 2.15-2.32 s, 2^16 1.78-2.09 s,
+// 2^18 1.88-2.00 s, and in a second sweep 2^16 1.86-2.12 s, 2^18 1.98-2.02 s (README, "Waves of
+// several samples"). Equal here; 2^18 for a GPU, which keeps about that many threads in flight.
+constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
+
+// The most bytes of one scene buffer on `device` with `settings`.
+std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
+
+// Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
+struct StageTimes {
+  std::array<double, kStageCount> seconds{};
+  std::array<std::uint64_t, kStageCount> launches{};
+};
+
+class Wavefront {
+ public:
+  // Packs and uploads the scene, allocates the path state and builds the program. `bvh` must have
+  // been built over `scene`'s triangles.
+  Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+            const RenderSettings& settings);
+
+  // Renders sample indices [sample, sample + samples) for every pixel and adds them to the film;
+  // 1 <= samples <= samples_per_wave().
+  void render_pass(std::uint32_t sample, std::uint32_t samples = 1);
+  // The device film read back: the sums of every pass rendered so far, which `info` describes
+  // (its size must be the settings'; its sample range is the passes', as the caller knows them).
+  Film film(FilmInfo info);
+  // Replaces the device film's sums with `film`'s (a checkpoint to continue); its size must be the
+  // settings'.
+  void load_film(const Film& film);
+  // NaN or infinite values dropped anywhere (queues.h, count_nonfinite).
+  std::uint64_t nonfinite_samples();
+  // Closest-hit rays (camera and bounce) traced by render_pass so far: a cost measure that, unlike
+  // time, does not depend on what else the machine is doing.
+  std::uint64_t rays_traced() const { return rays_traced_; }
+  // The packed scene on the device: its bytes and the buffers they are split over.
+  std::uint64_t scene_bytes() const { return scene_bytes_; }
+  int scene_buffer_count() const { return scene_buffer_count_; }
+
+  // Stage-level access for tests and benchmarks. Field offsets are those of path_state().layout,
+  // e.g. write_paths(path_state().layout.ray_o, rays).
+  // Returns the launch's event (with profiling information: the queue profiles).
+  cl::Event launch_stage(Stage stage, std::uint32_t items, const dev::Launch& params) {
+    return launch(stage, items, params);
+  }
+  template <class T>
+  void write_paths(dev::uint field_offset, const std::vector<T>& values) {
+    rt_.queue().enqueueWriteBuffer(path_buf_, CL_TRUE, field_offset, values.size() * sizeof(T),
+                                   values.data());
+  }
+  template <class T>
+  std::vector<T> read_paths(dev::uint field_offset, std::size_t count) {
+    std::vector<T> values(count);
+    rt_.queue().enqueueReadBuffer(path_buf_, CL_TRUE, field_offset, count * sizeof(T),
+                                  values.data());
+    return values;
+  }
+  // The wave loop in steps, for benchmarks that capture a real wavefront: start_wave generates
+  // the camera rays of a wave and returns the launch parameters of its first bounce; run_bounce
+  // runs one bounce's stages on `rays` queued rays and returns the next bounce's count, leaving
+  // `params` ready for it.
+  dev::Launch start_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                         std::uint32_t samples = 1);
+  std::uint32_t run_bounce(dev::Launch& params, std::uint32_t rays);
+  // The whole mutable device state except the film (path state, queues, counters), to replay a
+  // stage on the same input many times.
+  struct Snapshot {
+    std::vector<unsigned char> paths;
+    std::vector<dev::uint> slots, counters;
+  };
+  Snapshot snapshot();
+  void restore(const Snapshot& s);
+  std::uint32_t counter(std::uint32_t index) { return read_counter(index); }
+  // Replaces queue `queue` (WP_QUEUE_*) with `slots` and sets its counter; zeroes the others.
+  void write_queue(dev::uint queue, const std::vector<dev::uint>& slots);
+  // Launch parameters of the wave of `count` pixels from `first_pixel`, `samples` samples of each
+  // from index `sample`.
+  dev::Launch launch_params(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                            std::uint32_t samples = 1) const;
+  void finish() { rt_.queue().finish(); }
+
+  const SceneFeatures& features() const { return features_; }
+  const LightTable& lights() const { return lights_; }
+  const PathStateLayout& path_state() const { return path_state_; }
+  // Pixels per wave (one sample of each, or samples_per_wave() of them), and path slots per wave.
+  std::size_t wave_size() const { return wave_size_; }
+  std::size_t samples_per_wave() const { return samples_per_wave_; }
+  std::size_t wave_paths() const { return wave_size_ * samples_per_wave_; }
+  const StageTimes& stage_times() const { return times_; }
+  std::string build_options() const { return options_; }
+  // FNV-1a 64 of the program's source (all stage kernels, includes expanded): part of the render
+  // key (render.h), so films of different kernels do not merge.
+  std::uint64_t source_digest() const { return source_digest_; }
+  // Seconds spent building the program and compiling every kernel (see prime_kernels).
+  double build_seconds() const { return build_seconds_; }
+  // Size of the device program binary (implementation-specific: LLVM bitcode on PoCL, PTX on
+  // NVIDIA), 0 if the implementation does not report one.
+  std::size_t binary_bytes() const { return binary_bytes_; }
+  // Whether the program came from the kernel cache (RenderSettings::kernel_cache_dir).
+  bool kernel_cached() const { return kernel_cached_; }
+
+ private:
+  void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
+                std::uint32_t samples);
+  cl::Event launch(Stage stage, std::uint32_t items, const dev::Launch& params);
+  std::uint32_t read_counter(std::uint32_t index);
+  void collect_profile();
+  void prime_kernels();
+
+  ClRuntime& rt_;
+  RenderSettings settings_;
+  SceneFeatures features_;
+  LightTable lights_;
+  PathStateLayout path_state_;
+  std::size_t wave_size_ = 0;
+  std::size_t samples_per_wave_ = 1;
+  std::size_t local_size_ = 0;
+  double build_seconds_ = 0.0;
+  std::size_t binary_bytes_ = 0;
+  bool kernel_cached_ = false;
+  std::uint64_t rays_traced_ = 0;
+  std::string options_;
+  std::uint64_t source_digest_ = 0;
+
+  // The memory scene_ uses in place on a CPU device: declared first, so that it outlives the
+  // buffers.
+  std::vector<SceneBytes> packed_;
+  SceneBuffers scene_;
+  std::uint64_t scene_bytes_ = 0;
+  int scene_buffer_count_ = 0;
+  cl::Buffer path_buf_, queue_slots_, counters_, film_;
+  cl::Program program_;
+  // Every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h), accumulate the film after them.
+  // All but the Launch argument are set once, when the kernels are made.
+  std::vector<cl::Kernel> kernels_;  // indexed by Stage
+  cl_uint launch_arg_ = 0;           // the index of the Launch argument
+  std::vector<std::pair<Stage, cl::Event>> pending_events_;
+  StageTimes times_;
+};
+
+}  // namespace wp

@@ -1,0 +1,407 @@
+#include "host/scene/gltf_loader.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+#include <tiny_gltf.h>
+
+#include "host/util/error.h"
+#include "host/util/fnv1a.h"
+#include "host/scene/gltf_material.h"
+#include "host/scene/gltf_nodes.h"
+#include "host/scene/gltf_primitive.h"
+#include "host/scene/gltf_textures.h"
+
+namespace wp {
+namespace {
+
+const std::set<std::string> kSupportedExtensions = {
+    "KHR_lights_punctual",    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",      "KHR_materials_transmission",
+    "KHR_materials_unlit",    "KHR_materials_volume",
+    "KHR_materials_specular", "KHR_mesh_quantization",
+    "KHR_texture_transform"};
+
+// tinygltf's messages span lines; wavepath's errors are one line.
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    const std::size_t last = line.find_last_not_of(" \t\r");
+    if (first != std::string::npos) out.push_back(line.substr(first, last - first + 1));
+    start = end + 1;
+  }
+  return out;
+}
+
+std::string one_line(const std::string& text) {
+  std::string out;
+  for (const std::string& line : lines(text)) out += (out.empty() ? "" : "; ") + line;
+  return out.empty() ? "tinygltf gave no reason" : out;
+}
+
+std::vector<unsigned char> read_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw Error(path + ": no such file");
+  if (std::filesystem::is_directory(status)) throw Error(path + ": is a directory");
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
+  const std::streamoff size = in.tellg();
+  if (size <= 0) throw Error(path + ": empty file");
+  if (static_cast<std::uint64_t>(size) >= std::numeric_limits<std::uint32_t>::max())
+    throw Error(path + ": larger than 4 GiB, which glTF loading does not support");
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), size))
+    throw Error(path + ": read failed: " + std::strerror(errno));
+  return bytes;
+}
+
+bool has_glb_magic(const std::vector<unsigned char>& b) {
+  return b.size() >= 4 && std::memcmp(b.data(), "glTF", 4) == 0;
+}
+
+// Checks the .glb chunk layout and returns the length to parse. tinygltf 2.7.0 trusts a BIN
+// chunk's length up to 8 bytes past the declared end, so this check also keeps it in bounds.
+std::size_t check_glb(const std::vector<unsigned char>& b) {
+  if (b.size() < 20)
+    throw Error("truncated .glb: " + std::to_string(b.size()) + " bytes, the header needs 20");
+  const auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, &b[at], 4);  // glTF is little-endian, as are the hosts wavepath runs on
+    return std::uint64_t{v};
+  };
+  if (u32(4) != 2) throw Error("unsupported .glb version " + std::to_string(u32(4)));
+  const std::uint64_t length = u32(8);
+  if (length > b.size())
+    throw Error("truncated .glb: header declares " + std::to_string(length) + " bytes, file has " +
+                std::to_string(b.size()));
+  const std::uint64_t json_end = 20 + u32(12);
+  if (json_end > length)
+    throw Error("truncated .glb: JSON chunk ends at byte " + std::to_string(json_end) + " of " +
+                std::to_string(length));
+  if (u32(16) != 0x4E4F534Au) throw Error("invalid .glb: the first chunk is not JSON");
+  if (json_end + 8 <= length && json_end + 8 + u32(json_end) > length)
+    throw Error("truncated .glb: BIN chunk ends at byte " +
+                std::to_string(json_end + 8 + u32(json_end)) + " of " + std::to_string(length));
+  return static_cast<std::size_t>(length);
+}
+
+// tinygltf converts the parsed JSON into its model recursively, so a document nested thousands
+// deep (e.g. in free-form "extras") overflows the stack. glTF's own structure nests under ten
+// levels (nodes refer to each other by index), so anything deeper than this is refused before
+// tinygltf sees it.
+constexpr int kMaxJsonDepth = 64;
+
+// Counts [ and { nesting outside strings (skipping escaped characters) in JSON text.
+void check_json_depth(const unsigned char* text, std::size_t size) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < size; ++i) {
+    const unsigned char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // the escaped character cannot end the string
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error("JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
+// Parses the file with tinygltf (.glb when it starts with the binary magic, else JSON text);
+// tinygltf's warnings go to `warnings`, one line each; the file's FNV-1a digest to `digest`.
+tinygltf::Model parse(const std::string& path, std::vector<std::string>* warnings,
+                      std::uint64_t* digest) {
+  const std::vector<unsigned char> bytes = read_file(path);
+  *digest = fnv1a64(bytes.data(), bytes.size());
+  const bool glb = has_glb_magic(bytes);
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (!glb && (ext == ".glb" || ext == ".GLB"))
+    throw Error(path + ": not a binary glTF file (no 'glTF' magic)");
+
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(&gltf::keep_encoded_image, nullptr);  // decoded when used (gltf_textures)
+  tinygltf::Model model;
+  std::string err, warn;
+  const std::string base = std::filesystem::path(path).parent_path().string();
+  bool ok = false;
+  try {
+    if (glb) {
+      const std::size_t length = check_glb(bytes);
+      std::uint32_t json_length = 0;  // check_glb has checked that the chunk lies in the file
+      std::memcpy(&json_length, &bytes[12], 4);
+      check_json_depth(bytes.data() + 20, json_length);
+      ok = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                       static_cast<unsigned int>(length), base);
+    } else {
+      check_json_depth(bytes.data(), bytes.size());
+      ok = loader.LoadASCIIFromString(&model, &err, &warn,
+                                      reinterpret_cast<const char*>(bytes.data()),
+                                      static_cast<unsigned int>(bytes.size()), base);
+    }
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  } catch (const std::exception& e) {  // tinygltf 2.7.0 throws on some malformed input
+    throw Error(path + ": malformed glTF: " + one_line(e.what()));
+  }
+  if (!ok) throw Error(path + ": " + one_line(err));
+  for (const std::string* text : {&err, &warn})  // on success, err holds only remarks
+    for (const std::string& line : lines(*text)) warnings->push_back(path + ": " + line);
+  return model;
+}
+
+// Errors for required extensions wavepath lacks; a warning for each other unsupported one.
+void check_extensions(const tinygltf::Model& model, const std::string& path,
+                      std::vector<std::string>* warnings) {
+  std::string missing;
+  for (const std::string& name : model.extensionsRequired)
+    if (!kSupportedExtensions.count(name)) missing += (missing.empty() ? "" : ", ") + name;
+  if (!missing.empty())
+    throw Error(path + ": requires unsupported extension" +
+                (missing.find(',') != std::string::npos ? "s " : " ") + missing);
+  for (const std::string& name : model.extensionsUsed)
+    if (!kSupportedExtensions.count(name))
+      warnings->push_back(path + ": ignoring unsupported extension " + name);
+}
+
+// Fills the scene from the node tree of one glTF scene. Messages lack the file name; load_gltf
+// adds it.
+class SceneBuilder {
+ public:
+  SceneBuilder(const tinygltf::Model& model, Scene& scene) : model_(model), scene_(scene) {}
+
+  void build(int scene_index);
+
+ private:
+  void visit(int node, const glm::dmat4& world);
+  void add_mesh(int mesh, const glm::dmat4& world);
+  std::uint32_t material_index(int material);
+  gltf::VertexNeeds vertex_needs(std::uint32_t material) const;
+  void warn_once(int mesh, std::size_t primitive, const std::string& message);
+  static std::string revisit_message(const std::vector<int>& parent, int node, int from);
+
+  const tinygltf::Model& model_;
+  Scene& scene_;
+  std::optional<std::uint32_t> default_material_;
+  gltf::VertexNeeds file_needs_;  // uv1 and tangents: whether the scene keeps them at all
+  std::set<std::pair<int, std::size_t>> warned_;  // (mesh, primitive): instances warn once
+};
+
+// Depth-first, children in order, with an explicit stack: node order defines camera order, and
+// a deep hierarchy must not overflow the call stack.
+void SceneBuilder::build(int scene_index) {
+  const tinygltf::Scene& scene = model_.scenes[static_cast<std::size_t>(scene_index)];
+  for (const TextureRef& t : scene_.textures) file_needs_.uv1 |= t.texcoord == 1;
+  for (const Material& m : scene_.materials) file_needs_.tangents |= m.normal_texture >= 0;
+  constexpr int kUnvisited = -2, kRoot = -1;
+  std::vector<int> parent(model_.nodes.size(), kUnvisited);
+  struct Item {
+    int node, from;
+    glm::dmat4 parent_world;
+  };
+  std::vector<Item> stack;
+  for (auto it = scene.nodes.rbegin(); it != scene.nodes.rend(); ++it)
+    stack.push_back({*it, kRoot, glm::dmat4(1.0)});
+  while (!stack.empty()) {
+    const Item item = stack.back();
+    stack.pop_back();
+    if (item.node < 0 || static_cast<std::size_t>(item.node) >= model_.nodes.size())
+      throw Error((item.from == kRoot ? "scene " + std::to_string(scene_index)
+                                      : "node " + std::to_string(item.from)) +
+                  " refers to missing node " + std::to_string(item.node));
+    if (parent[static_cast<std::size_t>(item.node)] != kUnvisited)
+      throw Error(revisit_message(parent, item.node, item.from));
+    parent[static_cast<std::size_t>(item.node)] = item.from;
+    const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(item.node)];
+    const glm::dmat4 world = item.parent_world * gltf::local_transform(node, item.node);
+    visit(item.node, world);
+    for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
+      stack.push_back({*it, item.node, world});
+  }
+}
+
+std::string SceneBuilder::revisit_message(const std::vector<int>& parent, int node, int from) {
+  for (int n = from; n >= 0; n = parent[static_cast<std::size_t>(n)])
+    if (n == node) return "the node graph has a cycle through node " + std::to_string(node);
+  return "node " + std::to_string(node) + " is reached twice (glTF nodes form a tree)";
+}
+
+void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
+  const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
+  const std::string where = "node " + std::to_string(node_index) + ": ";
+  try {
+    if (node.mesh >= 0) add_mesh(node.mesh, world);
+    if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
+    const int light = gltf::node_light(node, node_index);
+    if (light >= 0) scene_.lights.push_back(gltf::make_light(model_, light, world));
+  } catch (const Error& e) {
+    throw Error(where + e.what());
+  }
+}
+
+void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
+  if (static_cast<std::size_t>(mesh_index) >= model_.meshes.size())
+    throw Error("mesh " + std::to_string(mesh_index) + " does not exist");
+  const tinygltf::Mesh& mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
+  for (std::size_t i = 0; i < mesh.primitives.size(); ++i) {
+    const tinygltf::Primitive& p = mesh.primitives[i];
+    if (p.mode < 0 || p.mode > 6)  // tinygltf gives 4 (TRIANGLES) when "mode" is absent
+      throw Error("mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(i) +
+                  ": mode " + std::to_string(p.mode) + " is not a glTF primitive mode (0-6)");
+    if (!gltf::is_triangle_mode(p.mode)) {
+      static const char* const kModes[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+      const std::string mode = p.mode <= 3 ? kModes[p.mode] : std::to_string(p.mode);
+      warn_once(mesh_index, i, "mode " + mode + " is not supported; skipped");
+      continue;
+    }
+    if (!p.attributes.count("POSITION")) {
+      warn_once(mesh_index, i, "no POSITION; skipped");
+      continue;
+    }
+    try {
+      const std::uint32_t material = material_index(p.material);
+      const std::size_t leftover =
+          gltf::append_primitive(model_, p, world, material, vertex_needs(material), scene_);
+      if (leftover != 0)
+        warn_once(
+            mesh_index, i,
+            "index count is not a multiple of 3; last " + std::to_string(leftover) + " ignored");
+    } catch (const Error& e) {
+      throw Error("mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(i) + ": " +
+                  e.what());
+    }
+  }
+}
+
+// Materials keep their glTF indices; glTF's default material follows them, added on first use.
+std::uint32_t SceneBuilder::material_index(int material) {
+  if (material >= 0) {
+    if (static_cast<std::size_t>(material) >= model_.materials.size())
+      throw Error("material " + std::to_string(material) + " does not exist");
+    return static_cast<std::uint32_t>(material);
+  }
+  if (!default_material_) {
+    default_material_ = static_cast<std::uint32_t>(scene_.materials.size());
+    scene_.materials.push_back(gltf::default_material());
+  }
+  return *default_material_;
+}
+
+// TEXCOORD_1 and tangents are kept for every vertex when any texture reads set 1 or any material
+// has a normal texture, and for none otherwise (scene.h).
+gltf::VertexNeeds SceneBuilder::vertex_needs(std::uint32_t material) const {
+  gltf::VertexNeeds needs = file_needs_;
+  const int normal = scene_.materials[material].normal_texture;
+  if (normal >= 0) needs.tangent_uv = scene_.textures[static_cast<std::size_t>(normal)].texcoord;
+  return needs;
+}
+
+void SceneBuilder::warn_once(int mesh, std::size_t primitive, const std::string& message) {
+  if (!warned_.insert({mesh, primitive}).second) return;
+  const std::string& name = model_.meshes[static_cast<std::size_t>(mesh)].name;
+  scene_.warnings.push_back(scene_.source + ": mesh " + std::to_string(mesh) +
+                            (name.empty() ? "" : " '" + name + "'") + " primitive " +
+                            std::to_string(primitive) + ": " + message);
+}
+
+void compute_bounds(Scene& scene) {
+  if (scene.positions.empty()) {  // an empty scene: a point at the origin, not inverted bounds
+    scene.bounds_lo = scene.bounds_hi = glm::vec3(0.0f);
+    return;
+  }
+  scene.bounds_lo = glm::vec3(std::numeric_limits<float>::max());
+  scene.bounds_hi = glm::vec3(std::numeric_limits<float>::lowest());
+  for (const glm::vec3& p : scene.positions) {
+    scene.bounds_lo = glm::min(scene.bounds_lo, p);
+    scene.bounds_hi = glm::max(scene.bounds_hi, p);
+  }
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+  Scene scene;
+  scene.source = path;
+  const tinygltf::Model model = parse(path, &scene.warnings, &scene.digest);
+  // The files the glTF file names (a GLB's own binary chunk is in its digest already).
+  for (const tinygltf::Buffer& b : model.buffers)
+    if (!b.uri.empty()) scene.digest = fnv1a64(b.data.data(), b.data.size(), scene.digest);
+  for (const tinygltf::Image& image : model.images)  // encoded bytes (keep_encoded_image)
+    if (image.bufferView < 0)
+      scene.digest = fnv1a64(image.image.data(), image.image.size(), scene.digest);
+  check_extensions(model, path, &scene.warnings);
+  try {
+    // glTF 1.0 files differ in structure; tinygltf reads some of them as 2.0 nonsense.
+    if (model.asset.version.rfind("2.", 0) != 0)
+      throw Error("asset.version \"" + model.asset.version.substr(0, 32) +
+                  "\" is not 2.x (only glTF 2.0 is supported)");
+    if (model.scenes.empty()) throw Error("the file has no scenes");
+    const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (static_cast<std::size_t>(scene_index) >= model.scenes.size())
+      throw Error("default scene " + std::to_string(scene_index) + " does not exist");
+    gltf::TextureTable textures(model, scene);
+    for (std::size_t i = 0; i < model.materials.size(); ++i)
+      scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i), textures));
+    SceneBuilder(model, scene).build(scene_index);
+    // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
+    if (scene.triangle_count() == 0)
+      scene.warnings.push_back(path + ": scene " + std::to_string(scene_index) +
+                               " has no triangles; only the background will be seen");
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+  compute_bounds(scene);
+  return scene;
+}
+
+Camera framing_camera(const Scene& scene, float aspect) {
+  const glm::vec3 center = 0.5f * (scene.bounds_lo + scene.bounds_hi);
+  float radius = 0.5f * glm::length(scene.bounds_hi - scene.bounds_lo);
+  // A point-sized (or broken) scene still gets a usable view: one scene unit across.
+  if (!(radius > 0.0f) || !std::isfinite(radius)) radius = 1.0f;
+  if (!(aspect > 0.0f) || !std::isfinite(aspect)) aspect = 1.0f;
+
+  Camera c;
+  c.name = "framing";
+  c.type = CameraType::kPerspective;
+  c.yfov = glm::radians(45.0f);
+  // The bounding sphere fits when the tighter half-angle of the view subtends its radius.
+  const float half_v = 0.5f * c.yfov;
+  const float half = std::min(half_v, std::atan(std::tan(half_v) * aspect));
+  const float distance = radius / std::sin(half);
+  const float elevation = glm::radians(15.0f);                           // "slightly from above"
+  const glm::vec3 back(0.0f, std::sin(elevation), std::cos(elevation));  // towards the camera
+  c.position =
+      std::isfinite(center.x + center.y + center.z) ? center + distance * back : distance * back;
+  c.forward = -back;
+  c.up = glm::vec3(0.0f, std::cos(elevation), -std::sin(elevation));
+  c.znear = 0.0f;  // nothing lies between the camera and the bounding sphere
+  return c;
+}
+
+}  // namespace wp

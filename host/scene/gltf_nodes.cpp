@@ -1,0 +1,138 @@
+#include "host/scene/gltf_nodes.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "host/util/error.h"
+#include "host/scene/gltf_values.h"
+
+namespace wp::gltf {
+namespace {
+
+// True when `v` is present; throws unless it has `size` finite numbers.
+bool present(const std::vector<double>& v, std::size_t size, const std::string& where,
+             const char* field) {
+  if (v.empty()) return false;
+  if (v.size() != size)
+    throw Error(where + ": " + field + " needs " + std::to_string(size) + " numbers, has " +
+                std::to_string(v.size()));
+  for (const double x : v)
+    if (!std::isfinite(x)) throw Error(where + ": " + field + " is not finite");
+  return true;
+}
+
+// Unit direction of `v`, or `fallback` when `v` has no direction (a zero scale).
+glm::dvec3 unit_or(const glm::dvec3& v, const glm::dvec3& fallback) {
+  const double len = glm::length(v);
+  return len > 0.0 && std::isfinite(len) ? v / len : fallback;
+}
+
+// The node's -Z (forward) and +Y (up, made orthogonal to forward) in world space, unit.
+void orientation(const glm::dmat4& world, glm::vec3* forward, glm::vec3* up) {
+  const glm::dmat3 m(world);
+  const glm::dvec3 f = unit_or(-m[2], glm::dvec3(0.0, 0.0, -1.0));
+  glm::dvec3 u = m[1] - glm::dot(m[1], f) * f;
+  if (!(glm::length(u) > 1e-9 * glm::length(m[1]))) {  // +Y along forward: any perpendicular
+    u = glm::cross(f, std::abs(f.x) < 0.9 ? glm::dvec3(1.0, 0.0, 0.0) : glm::dvec3(0.0, 1.0, 0.0));
+  }
+  *forward = glm::vec3(f);
+  *up = glm::vec3(glm::normalize(u));
+}
+
+}  // namespace
+
+glm::dmat4 local_transform(const tinygltf::Node& node, int index) {
+  const std::string where = "node " + std::to_string(index);
+  if (present(node.matrix, 16, where, "matrix")) return glm::make_mat4(node.matrix.data());
+  glm::dmat4 t(1.0), r(1.0), s(1.0);
+  if (present(node.translation, 3, where, "translation"))
+    t = glm::translate(glm::dmat4(1.0), glm::make_vec3(node.translation.data()));
+  if (present(node.rotation, 4, where, "rotation")) {
+    glm::dquat q;  // glTF stores x, y, z, w
+    q.x = node.rotation[0], q.y = node.rotation[1], q.z = node.rotation[2], q.w = node.rotation[3];
+    const double len = glm::length(q);
+    if (!(len > 0.0)) throw Error(where + ": rotation is a zero quaternion");
+    r = glm::mat4_cast(q / len);  // exporters round; a unit quaternion keeps r a rotation
+  }
+  if (present(node.scale, 3, where, "scale"))
+    s = glm::scale(glm::dmat4(1.0), glm::make_vec3(node.scale.data()));
+  return t * r * s;
+}
+
+Camera make_camera(const tinygltf::Model& model, int index, const glm::dmat4& world) {
+  if (index < 0 || static_cast<std::size_t>(index) >= model.cameras.size())
+    throw Error("camera " + std::to_string(index) + " does not exist");
+  const tinygltf::Camera& in = model.cameras[static_cast<std::size_t>(index)];
+  const std::string where = "camera " + std::to_string(index) + " '" + in.name + "'";
+  Camera out;
+  out.name = in.name;
+  if (in.type == "perspective") {
+    out.type = CameraType::kPerspective;
+    out.yfov = finite(in.perspective.yfov, where, "yfov");
+    out.znear = finite(in.perspective.znear, where, "znear");
+    if (!(out.yfov > 0.0f && out.yfov < 3.14159f)) throw Error(where + ": yfov out of (0, pi)");
+  } else if (in.type == "orthographic") {
+    out.type = CameraType::kOrthographic;
+    out.xmag = finite(in.orthographic.xmag, where, "xmag");
+    out.ymag = finite(in.orthographic.ymag, where, "ymag");
+    out.znear = finite(in.orthographic.znear, where, "znear");
+    if (out.xmag == 0.0f || out.ymag == 0.0f) throw Error(where + ": zero xmag or ymag");
+  } else {
+    throw Error(where + ": unknown type '" + in.type + "'");
+  }
+  if (out.znear < 0.0f) throw Error(where + ": negative znear");
+  out.position = glm::vec3(world[3]);
+  orientation(world, &out.forward, &out.up);
+  return out;
+}
+
+int node_light(const tinygltf::Node& node, int index) {
+  const auto it = node.extensions.find("KHR_lights_punctual");
+  if (it == node.extensions.end()) return -1;
+  const tinygltf::Value& ext = it->second;
+  if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsInt())
+    throw Error("node " + std::to_string(index) + ": KHR_lights_punctual has no integer 'light'");
+  return ext.Get("light").GetNumberAsInt();
+}
+
+PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world) {
+  if (index < 0 || static_cast<std::size_t>(index) >= model.lights.size())
+    throw Error("light " + std::to_string(index) + " does not exist");
+  const tinygltf::Light& in = model.lights[static_cast<std::size_t>(index)];
+  const std::string where = "light " + std::to_string(index) + " '" + in.name + "'";
+  PunctualLight out;
+  out.name = in.name;
+  if (in.type == "point") {
+    out.type = LightType::kPoint;
+  } else if (in.type == "spot") {
+    out.type = LightType::kSpot;
+  } else if (in.type == "directional") {
+    out.type = LightType::kDirectional;
+  } else {
+    throw Error(where + ": unknown type '" + in.type + "'");
+  }
+  glm::vec3 color(1.0f);
+  if (present(in.color, 3, where, "color"))
+    for (int i = 0; i < 3; ++i)
+      color[i] = in_range(in.color[static_cast<std::size_t>(i)], 0.0, 1.0, where, "color");
+  out.intensity = color * in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
+  out.range = finite(in.range, where, "range");
+  // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out; the
+  // extension asks 0 <= inner < outer <= pi/2.
+  out.inner_cone = in_range(in.spot.innerConeAngle, 0.0, M_PI / 2, where, "innerConeAngle");
+  out.outer_cone = in_range(in.spot.outerConeAngle, 0.0, M_PI / 2, where, "outerConeAngle");
+  if (out.type == LightType::kSpot && !(out.inner_cone < out.outer_cone))
+    throw Error(where + ": innerConeAngle " + number_text(in.spot.innerConeAngle) +
+                " is not below outerConeAngle " + number_text(in.spot.outerConeAngle));
+  out.position = glm::vec3(world[3]);
+  out.direction = glm::vec3(unit_or(-glm::dmat3(world)[2], glm::dvec3(0.0, 0.0, -1.0)));
+  return out;
+}
+
+}  // namespace wp::gltf

@@ -1,0 +1,259 @@
+#include "host/scene/gltf_textures.h"
+
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include <stb_image.h>
+
+#include "host/util/error.h"
+
+namespace wp::gltf {
+namespace {
+
+constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728;
+
+std::string image_name(const tinygltf::Model& model, int index) {
+  const tinygltf::Image& image = model.images[static_cast<std::size_t>(index)];
+  std::string s = "image " + std::to_string(index);
+  if (!image.name.empty()) s += " '" + image.name + "'";
+  if (!image.uri.empty() && image.uri.compare(0, 5, "data:") != 0) s += " (" + image.uri + ")";
+  return s;
+}
+
+Wrap wrap_mode(int mode, const std::string& where, const char* field) {
+  if (mode == kRepeat) return Wrap::kRepeat;
+  if (mode == kClampToEdge) return Wrap::kClampToEdge;
+  if (mode == kMirroredRepeat) return Wrap::kMirroredRepeat;
+  throw Error(where + ": unknown " + field + " " + std::to_string(mode));
+}
+
+double finite_number(const tinygltf::Value& v, const std::string& where, const char* field) {
+  if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+    throw Error(where + "." + field + " is not a finite number");
+  return v.GetNumberAsDouble();
+}
+
+// A two-number array member of `object`, or `fallback` when absent.
+glm::dvec2 vec2_member(const tinygltf::Value& object, const char* field, glm::dvec2 fallback,
+                       const std::string& where) {
+  if (!object.Has(field)) return fallback;
+  const tinygltf::Value& v = object.Get(field);
+  if (!v.IsArray() || v.ArrayLen() != 2) throw Error(where + "." + field + " needs 2 numbers");
+  return {finite_number(v.Get(0), where, field), finite_number(v.Get(1), where, field)};
+}
+
+int int_member(const tinygltf::Value& object, const char* field, int fallback,
+               const std::string& where) {
+  if (!object.Has(field)) return fallback;
+  const tinygltf::Value& v = object.Get(field);
+  if (!v.IsInt()) throw Error(where + "." + field + " is not an integer");
+  return v.GetNumberAsInt();
+}
+
+const tinygltf::Value* transform_of(const tinygltf::ExtensionMap& extensions) {
+  const auto it = extensions.find("KHR_texture_transform");
+  return it == extensions.end() ? nullptr : &it->second;
+}
+
+bool same_use(const TextureRef& a, const TextureRef& b) {
+  return a.image == b.image && a.wrap_s == b.wrap_s && a.wrap_t == b.wrap_t &&
+         a.nearest == b.nearest && a.srgb == b.srgb && a.texcoord == b.texcoord &&
+         a.row_u == b.row_u && a.row_v == b.row_v;
+}
+
+// A PNG's chunks, walked before stb_image sees the file: every chunk's length must fit in the
+// bytes that follow it, and the image data must be able to hold the image. stb_image allocates
+// an IDAT chunk's claimed length (doubling its buffer up to it) before reading it, so a 42 KB
+// file whose IDAT claimed 2 GB made it allocate 2 GiB (fuzzing); and it allocates the decoded
+// image from IHDR's size. Deflate expands at most 1,032-fold, so the filtered rows,
+// height x (1 + width x bits per pixel / 8) bytes, cannot exceed 1,032 x the IDAT bytes (plus
+// slack for the filter bytes of interlaced passes). Not a PNG (no signature): nothing to check.
+void check_png_chunks(const unsigned char* bytes, std::size_t size, const std::string& what) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || std::memcmp(bytes, kSignature, 8) != 0) return;
+  const auto u32 = [&](std::size_t at) {
+    return std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
+           std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+  };
+  double row_bits = 0, rows = 0, idat = 0;
+  std::size_t at = 8;
+  while (at < size) {
+    if (size - at < 12) throw Error(what + ": truncated PNG chunk at byte " + std::to_string(at));
+    const std::size_t length = u32(at);
+    if (length > size - at - 12)
+      throw Error(what + ": PNG chunk at byte " + std::to_string(at) + " claims " +
+                  std::to_string(length) + " bytes, more than the file has");
+    const unsigned char* type = bytes + at + 4;
+    if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13) {
+      const unsigned depth = bytes[at + 16], color = bytes[at + 17];
+      const unsigned samples = color == 2 ? 3 : color == 4 ? 2 : color == 6 ? 4 : 1;
+      row_bits = double(u32(at + 8)) * samples * depth;
+      rows = double(u32(at + 12));
+    } else if (std::memcmp(type, "IDAT", 4) == 0) {
+      idat += double(length);
+    } else if (std::memcmp(type, "IEND", 4) == 0) {
+      break;
+    }
+    at += 12 + length;
+  }
+  const double filtered = rows * (1.0 + std::ceil(row_bits / 8.0));
+  if (filtered > 1032.0 * idat + 8.0 * rows + 65536.0) {
+    // As text from the doubles: the rows' size may exceed any integer type (fuzzing: 3e19).
+    char message[128];
+    std::snprintf(message, sizeof message,
+                  "PNG image data of %.0f bytes cannot hold its %.0f bytes of rows", idat,
+                  filtered);
+    throw Error(what + ": " + message);
+  }
+}
+
+}  // namespace
+
+bool keep_encoded_image(tinygltf::Image* image, int, std::string*, std::string*, int, int,
+                        const unsigned char* bytes, int size, void*) {
+  if (image->bufferView < 0 && bytes && size > 0) image->image.assign(bytes, bytes + size);
+  return true;
+}
+
+TextureInfo texture_info(const tinygltf::TextureInfo& info) {
+  return {info.index, info.texCoord, transform_of(info.extensions)};
+}
+
+TextureInfo texture_info(const tinygltf::NormalTextureInfo& info) {
+  return {info.index, info.texCoord, transform_of(info.extensions)};
+}
+
+TextureInfo texture_info(const tinygltf::Value& object, const std::string& where) {
+  if (!object.IsObject()) throw Error(where + " is not an object");
+  TextureInfo info;
+  info.index = int_member(object, "index", -1, where);
+  if (info.index < 0) throw Error(where + " has no valid index");
+  info.texcoord = int_member(object, "texCoord", 0, where);
+  if (object.Has("extensions")) {
+    const tinygltf::Value& ext = object.Get("extensions");
+    if (ext.IsObject() && ext.Has("KHR_texture_transform"))
+      info.transform = &ext.Get("KHR_texture_transform");
+  }
+  return info;
+}
+
+// The extension's matrix T(offset) R(rotation) S(scale) has rows (c sx, s sy, ox) and
+// (-s sx, c sy, oy), c = cos(rotation), s = sin(rotation): UVs turn counter-clockwise, the image
+// clockwise, as the extension's example (offset [0, 1], rotation pi/2, scale 0.5 selects the
+// lower left quadrant) and the Khronos sample viewer have it. (The extension's GLSL listing, read
+// as GLSL's column-major constructor, has the opposite sign of rotation and contradicts that
+// example.)
+void texture_transform(const tinygltf::Value* transform, const std::string& where, TextureRef& ref,
+                       int& texcoord) {
+  if (!transform) return;
+  const std::string at = where + ".KHR_texture_transform";
+  if (!transform->IsObject()) throw Error(at + " is not an object");
+  const glm::dvec2 offset = vec2_member(*transform, "offset", glm::dvec2(0.0), at);
+  const glm::dvec2 scale = vec2_member(*transform, "scale", glm::dvec2(1.0), at);
+  const double rotation =
+      transform->Has("rotation") ? finite_number(transform->Get("rotation"), at, "rotation") : 0.0;
+  texcoord = int_member(*transform, "texCoord", texcoord, at);
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  ref.row_u = glm::vec3(glm::dvec3(c * scale.x, s * scale.y, offset.x));
+  ref.row_v = glm::vec3(glm::dvec3(-s * scale.x, c * scale.y, offset.y));
+}
+
+TextureTable::TextureTable(const tinygltf::Model& model, Scene& scene)
+    : model_(model), scene_(scene), image_slot_(model.images.size(), -1) {}
+
+void TextureTable::warn(const std::string& message) {
+  scene_.warnings.push_back(scene_.source + ": " + message);
+}
+
+int TextureTable::add(const TextureInfo& info, bool srgb, const std::string& where) {
+  if (info.index < 0) return -1;
+  if (static_cast<std::size_t>(info.index) >= model_.textures.size())
+    throw Error(where + ": texture " + std::to_string(info.index) + " does not exist");
+  const tinygltf::Texture& texture = model_.textures[static_cast<std::size_t>(info.index)];
+  const std::string tex_where = where + ": texture " + std::to_string(info.index);
+  TextureRef ref;
+  int texcoord = info.texcoord;
+  texture_transform(info.transform, where, ref, texcoord);
+  if (texcoord < 0) throw Error(where + ": texCoord " + std::to_string(texcoord) + " is negative");
+  if (texcoord > 1) {
+    warn(where + ": TEXCOORD_" + std::to_string(texcoord) +
+         " is not supported (only 0 and 1); texture ignored");
+    return -1;
+  }
+  if (texture.source < 0) {  // e.g. only an extension's source (KTX2, WebP)
+    warn(tex_where + " has no PNG or JPEG source; ignored");
+    return -1;
+  }
+  if (static_cast<std::size_t>(texture.source) >= model_.images.size())
+    throw Error(tex_where + ": image " + std::to_string(texture.source) + " does not exist");
+  if (texture.sampler >= 0) {
+    if (static_cast<std::size_t>(texture.sampler) >= model_.samplers.size())
+      throw Error(tex_where + ": sampler " + std::to_string(texture.sampler) + " does not exist");
+    const tinygltf::Sampler& s = model_.samplers[static_cast<std::size_t>(texture.sampler)];
+    const std::string sampler_where = "sampler " + std::to_string(texture.sampler);
+    ref.wrap_s = wrap_mode(s.wrapS, sampler_where, "wrapS");
+    ref.wrap_t = wrap_mode(s.wrapT, sampler_where, "wrapT");
+    ref.nearest = s.magFilter == kNearest;
+  }
+  ref.srgb = srgb;
+  ref.texcoord = texcoord;
+  ref.image = image(texture.source);
+  for (std::size_t i = 0; i < scene_.textures.size(); ++i)
+    if (same_use(scene_.textures[i], ref)) return static_cast<int>(i);
+  scene_.textures.push_back(ref);
+  return static_cast<int>(scene_.textures.size() - 1);
+}
+
+// Decodes image `index` on first use: from its bufferView (checked against the buffer) or from
+// the bytes keep_encoded_image kept for a URI.
+int TextureTable::image(int index) {
+  int& slot = image_slot_[static_cast<std::size_t>(index)];
+  if (slot >= 0) return slot;
+  const tinygltf::Image& in = model_.images[static_cast<std::size_t>(index)];
+  const std::string what = image_name(model_, index);
+  const unsigned char* bytes = in.image.data();
+  std::size_t size = in.image.size();
+  if (in.bufferView >= 0) {
+    if (static_cast<std::size_t>(in.bufferView) >= model_.bufferViews.size())
+      throw Error(what + ": bufferView " + std::to_string(in.bufferView) + " does not exist");
+    const tinygltf::BufferView& view = model_.bufferViews[static_cast<std::size_t>(in.bufferView)];
+    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model_.buffers.size())
+      throw Error(what + ": buffer " + std::to_string(view.buffer) + " does not exist");
+    const std::vector<unsigned char>& data =
+        model_.buffers[static_cast<std::size_t>(view.buffer)].data;
+    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
+      throw Error(what + ": bufferView " + std::to_string(in.bufferView) + " exceeds buffer " +
+                  std::to_string(view.buffer));
+    bytes = data.data() + view.byteOffset;
+    size = view.byteLength;
+  }
+  if (size == 0) throw Error(what + ": no image data (file missing or unreadable?)");
+  if (size > static_cast<std::size_t>(INT_MAX)) throw Error(what + ": larger than 2 GiB");
+  check_png_chunks(bytes, size, what);
+  int width = 0, height = 0, channels = 0;
+  // At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before stb_image allocates them.
+  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels) &&
+      double(width) * double(height) > double(1u << 28))
+    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
+                " pixels, more than the 16384 x 16384 a texture may have");
+  unsigned char* pixels =
+      stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    throw Error(what + ": cannot decode: " + (reason ? reason : "unknown format"));
+  }
+  Image out;
+  out.name = in.name.empty() ? in.uri.substr(0, 64) : in.name;
+  out.width = width;
+  out.height = height;
+  out.rgba.assign(pixels, pixels + std::size_t(4) * std::size_t(width) * std::size_t(height));
+  stbi_image_free(pixels);
+  slot = static_cast<int>(scene_.images.size());
+  scene_.images.push_back(std::move(out));
+  return slot;
+}
+
+}  // namespace wp::gltf
