@@ -1,71 +1,13 @@
-/* Stage: film accumulation, once per sample pass and wave, after the last bounce.
- * From: every slot of the wave [0, path_count) (finished paths keep their slot).
- * To:   the film, in fixed point (layout, scale and ranges in shared/film.h): per pixel and
- *       channel the 128-bit sums S += a and Q += floor(a^2 / 2^32), a = round(radiance * 2^32)
- *       saturated to [0, 2^64 - 1] (values from 2^32 on saturate). No sum overflows: a < 2^64
- *       and a^2 / 2^32 < 2^96, so 2^20 samples (the most a film holds) give S < 2^84 and
- *       Q < 2^116. Integer sums do not depend on the order of addition, so films of sample
- *       ranges rendered apart merge bit for bit (host/film/film.h). A sample that is NaN or infinite
- *       is not added; it is counted in counters[WP_COUNTER_NONFINITE] (the renderer reports the
- *       count, the tests require 0) and weighs as 0 in the mean (S / 2^32 / spp).
- *
- * Radiance is never negative for a valid scene (emission, lights, the background and the
- * environment are non-negative, and so are BSDF values, cosines and MIS weights; the loader
- * refuses factors outside glTF's ranges). A negative value would saturate to 0.
- *
- * Each pixel is in one slot of a wave and waves run one after another, so the adds need no
- * atomics. */
-#include "stage.h"
-#include "shared/film.h"
+/* Stage: film accumulation (integrator/accumulate.h), once per sample pass and wave, after the
+ * last bounce.
+ * From: every slot of the wave [0, path_count) (finished paths keep their slot), one work-item per
+ *       pixel of the wave.
+ * To:   the film, in fixed point. Each pixel is in one work-item and waves run one after another,
+ *       so the adds need no atomics. */
+#include "integrator/accumulate.h"
 
-/* v += (hi, lo), 128-bit values stored as two words, the low one first. */
-static inline void film_add128(__global ulong* v, ulong lo, ulong hi) {
-  const ulong sum = v[0] + lo;
-  v[1] += hi + (sum < lo ? 1ul : 0ul); /* the carry; hi < 2^64 - 1 here, so no overflow */
-  v[0] = sum;
-}
-
-/* Adds one channel's value v to the sums at `px` (the pixel's first word). */
-static inline void film_add_value(__global ulong* px, uint channel, float v) {
-  const ulong a = convert_ulong_sat_rte(v * 0x1p32f);
-  const ulong sq_lo = a * a, sq_hi = mul_hi(a, a); /* a^2, 128 bits */
-  film_add128(px + WP_FILM_SUM(channel), a, 0ul);
-  film_add128(px + WP_FILM_SQUARES(channel), (sq_hi << 32) | (sq_lo >> 32), sq_hi >> 32);
-}
-
-/* The sums' stride: 12 words per pixel, 26 with AOVs. */
-#define WP_FILM_STRIDE WP_FILM_WORDS(WP_AOV)
-
-#if WP_AOV
-/* Adds one sample's AOVs: albedo, normal + 1 and depth, one 128-bit sum each (shared/film.h). */
-static inline void film_add_aovs(__global ulong* px, float4 albedo, float4 normal) {
-  const float a[3] = {albedo.x, albedo.y, albedo.z}, n[3] = {normal.x, normal.y, normal.z};
-  for (uint c = 0; c < 3u; ++c) {
-    film_add128(px + WP_FILM_ALBEDO(c), convert_ulong_sat_rte(a[c] * 0x1p32f), 0ul);
-    film_add128(px + WP_FILM_NORMAL(c), convert_ulong_sat_rte((n[c] + 1.0f) * 0x1p32f), 0ul);
-  }
-  film_add128(px + WP_FILM_DEPTH, convert_ulong_sat_rte(albedo.w * 0x1p32f), 0ul);
-}
-#endif
-
-/* One work-item per pixel of the wave, adding each of the wave's samples of it in turn (slots
- * i, i + wave_pixels, ...: stage.h, path_sample), so no two work-items write one pixel. */
 __kernel void accumulate(WP_STAGE_PARAMS, __global ulong* film) {
   WP_STAGE_BIND;
   const uint first = get_global_id(0);
-  if (first >= launch.wave_pixels) return;
-  __global ulong* px = film + (size_t)paths.info[first].x * WP_FILM_STRIDE;
-  for (uint slot = first; slot < launch.path_count; slot += launch.wave_pixels) {
-#if WP_AOV /* every sample once, also one whose radiance is dropped below */
-    film_add_aovs(px, paths.aov_albedo[slot], paths.aov_normal[slot]);
-#endif
-    const float3 l = paths.radiance[slot].xyz;
-    if (!all(isfinite(l))) {
-      count_nonfinite(queues);
-      continue;
-    }
-    film_add_value(px, 0u, l.x);
-    film_add_value(px, 1u, l.y);
-    film_add_value(px, 2u, l.z);
-  }
+  if (first < launch.wave_pixels) accumulate_pixel(paths, queues, launch, film, first);
 }

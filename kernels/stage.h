@@ -1,5 +1,6 @@
-/* What every wavefront stage kernel includes: the scene, the path state, the queues and the
- * randomness, and the one argument list all stage kernels share. */
+/* What every wavefront stage includes: the scene, the path state, the queues and the randomness,
+ * the one argument list all stage kernels share, and the helpers the stages have in common. Each
+ * stage's logic is in integrator/<stage>.h; kernels/<stage>.cl is its entry point. */
 #ifndef WP_STAGE_H
 #define WP_STAGE_H
 
@@ -9,8 +10,7 @@
 #include "queues.h"
 #include "scene.h"
 
-/* The arguments every stage kernel takes, in this order (host/render/stages.h launches them typed).
- */
+/* The arguments every stage kernel takes, in this order (host/render/wavefront.cpp binds them). */
 #define WP_STAGE_PARAMS                                                                          \
   WP_SCENE_PARAMS, __global uchar *path_buf, PathLayout path_layout, __global uint *queue_slots, \
       __global uint *queue_counters, Launch launch
@@ -35,6 +35,9 @@ static inline bool prefetch_slot(Queues queues, uint q, uint index, uint* slot) 
   return WP_PREFETCH && queue_get(queues, q, index + WP_PREFETCH_AHEAD, slot);
 }
 
+/* Hints the cache at path-state field `field` of `slot` (a field of Paths, not a lane). */
+#define prefetch_path(paths, field, slot) wp_prefetch((paths).field + (slot))
+
 /* The sample index of the path in `slot`: a wave holds one or more samples of its pixels, one after
  * another (Launch.wave_pixels). */
 static inline uint path_sample(Launch launch, uint slot) {
@@ -43,17 +46,17 @@ static inline uint path_sample(Launch launch, uint slot) {
 
 /* The random numbers of the path in `slot` at bounce `bounce`. */
 static inline Rng path_rng_at(Paths paths, uint slot, Launch launch, uint bounce) {
-  return rng_make(paths.info[slot].x, path_sample(launch, slot), launch.seed, bounce);
+  return rng_make(path_pixel(paths, slot), path_sample(launch, slot), launch.seed, bounce);
 }
 
 /* The random numbers of the path in `slot` at its current bounce. */
 static inline Rng path_rng(Paths paths, uint slot, Launch launch) {
-  return path_rng_at(paths, slot, launch, paths.info[slot].y);
+  return path_rng_at(paths, slot, launch, path_bounce(paths, slot));
 }
 
 /* The random numbers one scattering event draws (rng.h's per-bounce dimensions), all at once
  * (rng_bounce): the fused kernel draws them before it needs any, as independent chains the CPU
- * overlaps; drawn at their point of use, each one's latency held up the work that needed it. */
+ * overlaps; drawn at their point of use, each one's latency holds up the work that needs it. */
 typedef struct BounceRandom {
   float light_pick, lobe, roulette;
   float2 light_uv, bsdf_uv;

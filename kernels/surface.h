@@ -1,4 +1,5 @@
-/* The surface record that shade_surface leaves in the path state for the stages after it. */
+/* The surface record that shade_surface leaves in the path state for the split stages after it
+ * (the path_surf_* lanes of shared/path_state.def), and where rays leave a surface. */
 #ifndef WP_SURFACE_H
 #define WP_SURFACE_H
 
@@ -6,28 +7,32 @@
 #include "path_state.h"
 
 static inline void surface_store(Paths paths, uint slot, const Surface* s) {
-  paths.surf_p[slot] = (float4)(s->p, s->p_scale);
-  paths.surf_ng[slot] = (float4)(s->ng, s->specular);
-  paths.surf_ns[slot] = (float4)(s->ns, 0.0f);
-  paths.surf_color[slot] = (float4)(s->color, s->metallic);
-  paths.surf_params[slot] = (float4)(s->roughness, s->ior, s->transmission, as_float(s->flags));
+  path_set_surf_p(paths, slot, s->p);
+  path_set_surf_p_scale(paths, slot, s->p_scale);
+  path_set_surf_ng(paths, slot, s->ng);
+  path_set_surf_specular(paths, slot, s->specular);
+  path_set_surf_ns(paths, slot, s->ns);
+  path_set_surf_color(paths, slot, s->color);
+  path_set_surf_metallic(paths, slot, s->metallic);
+  path_set_surf_roughness(paths, slot, s->roughness);
+  path_set_surf_ior(paths, slot, s->ior);
+  path_set_surf_transmission(paths, slot, s->transmission);
+  path_set_surf_flags(paths, slot, s->flags);
 }
 
 static inline Surface surface_load(Paths paths, uint slot) {
   Surface s;
-  const float4 p = paths.surf_p[slot];
-  s.p = p.xyz;
-  s.p_scale = p.w;
-  const float4 ng = paths.surf_ng[slot];
-  s.ng = ng.xyz;
-  s.specular = ng.w;
-  s.ns = paths.surf_ns[slot].xyz;
-  const float4 c = paths.surf_color[slot];
-  const float4 q = paths.surf_params[slot];
-  s.color = c.xyz;
-  s.metallic = c.w;
-  s.roughness = q.x, s.ior = q.y, s.transmission = q.z;
-  s.flags = as_uint(q.w);
+  s.p = path_surf_p(paths, slot);
+  s.p_scale = path_surf_p_scale(paths, slot);
+  s.ng = path_surf_ng(paths, slot);
+  s.specular = path_surf_specular(paths, slot);
+  s.ns = path_surf_ns(paths, slot);
+  s.color = path_surf_color(paths, slot);
+  s.metallic = path_surf_metallic(paths, slot);
+  s.roughness = path_surf_roughness(paths, slot);
+  s.ior = path_surf_ior(paths, slot);
+  s.transmission = path_surf_transmission(paths, slot);
+  s.flags = path_surf_flags(paths, slot);
   return s;
 }
 

@@ -39,7 +39,7 @@
 #define WP_CAMERA_PERSPECTIVE 0u
 #define WP_CAMERA_ORTHOGRAPHIC 1u
 
-/* Path flags (info.z in the path state). */
+/* Path flags (path_flags in the path state). */
 #define WP_PATH_DELTA 1u /* the last scattering event was a delta (specular) lobe */
 
 /* Queues: index arrays of path slots with an atomic counter each (see kernels/queues.h). */
@@ -165,15 +165,14 @@ typedef struct Launch {
   uint path_count;    /* paths in this wave (<= the path capacity): wave_pixels x its samples */
   uint sample;        /* the wave's first sample index (0..spp-1) */
   uint seed;          /* user seed */
-  uint bounce;        /* 0 for camera rays */
   uint max_depth;     /* paths end after this many scattering events */
   uint rr_depth;      /* Russian roulette from this bounce on; >= max_depth: never */
   uint queue_in;      /* WP_QUEUE_* the stage reads */
   uint queue_out;     /* WP_QUEUE_* the stage appends to */
   uint wave_pixels; /* pixels in this wave: path slot i renders pixel pixel_offset + i % wave_pixels
                        at sample index sample + i / wave_pixels (stage.h, path_sample) */
-  float rr_threshold; /* roulette ends paths whose throughput is below this (roulette_compact.cl) */
-  uint pad[3];        /* to 64 bytes, a multiple of 16 on every device */
+  float rr_threshold; /* roulette ends paths whose throughput is below this (roulette_compact.h) */
+  uint pad[4];        /* to 64 bytes, a multiple of 16 on every device */
 } Launch;
 
 WP_DEV_END

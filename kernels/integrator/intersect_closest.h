@@ -1,0 +1,34 @@
+/* Closest-hit intersection for one path: its ray (path_ray_*) against the BVH, the hit record
+ * (path_hit_*) out, t = INFINITY for a miss. Entry point: intersect_closest.cl. */
+#ifndef WP_INTEGRATOR_INTERSECT_CLOSEST_H
+#define WP_INTEGRATOR_INTERSECT_CLOSEST_H
+
+#include "stage.h"
+#include "traverse.h"
+
+/* The fields intersect_path reads and writes, for the cache hints of the slot ahead. */
+static inline void intersect_prefetch(Paths paths, uint slot) {
+  prefetch_path(paths, ray_o, slot);
+  prefetch_path(paths, ray_d, slot);
+  prefetch_path(paths, hit, slot);
+}
+
+WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch launch, uint slot) {
+  const uint key = rng_bits(path_rng(paths, slot, launch), WP_DIM_ALPHA_CLOSEST);
+  const TraceRay ray = trace_ray(path_ray_origin(paths, slot), path_ray_dir(paths, slot),
+                                 path_ray_tmin(paths, slot), key);
+  TraceHit hit;
+  if (bvh_trace(scene, &ray, path_ray_tmax(paths, slot), &hit, false)) {
+    path_set_hit_t(paths, slot, hit.t);
+    path_set_hit_u(paths, slot, hit.u);
+    path_set_hit_v(paths, slot, hit.v);
+    path_set_hit_triangle(paths, slot, hit.tri);
+  } else {
+    path_set_hit_t(paths, slot, INFINITY);
+    path_set_hit_u(paths, slot, 0.0f);
+    path_set_hit_v(paths, slot, 0.0f);
+    path_set_hit_triangle(paths, slot, 0u);
+  }
+}
+
+#endif /* WP_INTEGRATOR_INTERSECT_CLOSEST_H */

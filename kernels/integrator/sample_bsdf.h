@@ -1,0 +1,50 @@
+/* BSDF sampling for one path: the next ray from the surface, throughput *= f cos / pdf, the
+ * sample's pdf (0 for a delta lobe) and WP_PATH_DELTA kept for MIS at the next hit, and a
+ * refraction into another medium multiplying the eta scale by eta^2. A path with no valid
+ * direction gets throughput 0, which roulette ends, as it does a path whose throughput or pdf would
+ * be NaN/Inf (counted, queues.h). Through a smooth thin-walled transmitter the previous sample's
+ * pdf, flags and distance are carried on (below). Used by sample_bsdf.cl and the fused shade.cl. */
+#ifndef WP_INTEGRATOR_SAMPLE_BSDF_H
+#define WP_INTEGRATOR_SAMPLE_BSDF_H
+
+#include "stage.h"
+#include "surface.h"
+
+/* The next ray of the path in `slot` from surface s with the bounce's random numbers u (its lobe
+ * choice and direction). */
+WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Surface* s,
+                                 const BounceRandom* u) {
+  const float3 ray_d = path_ray_dir(paths, slot);
+  const BsdfSample bs = bsdf_sample(s, -ray_d, u->lobe, u->bsdf_uv);
+  const float3 next = path_throughput(paths, slot) * bs.weight;
+  const bool finite = all(isfinite(next)) && isfinite(bs.pdf);
+  if (bs.valid && !finite) count_nonfinite(queues);
+  if (!bs.valid || !finite) {
+    path_set_throughput(paths, slot, (float3)(0.0f));
+    path_set_bsdf_pdf(paths, slot, 0.0f);
+    return;
+  }
+  path_set_eta_scale(paths, slot, path_eta_scale(paths, slot) * bs.eta_scale);
+  path_set_throughput(paths, slot, next);
+#if WP_FEATURE_TRANSMISSION
+  /* Straight through a smooth thin-walled transmitter, which shadow rays pass too (trace_shadow):
+   * the path goes on along the direction the previous vertex sampled, so it keeps that sample's
+   * pdf and flags for MIS at the next hit, and counts the distance to that vertex for the light's
+   * pdf there. */
+  if (bs.delta && !bsdf_volume(s) && dot(bs.wi, s->ng) < 0.0f) {
+    path_set_pane_distance(paths, slot, path_pane_distance(paths, slot) + path_hit_t(paths, slot));
+  } else
+#endif
+  {
+    path_set_bsdf_pdf(paths, slot, bs.pdf);
+    path_set_flags(paths, slot, bs.delta ? WP_PATH_DELTA : 0u);
+    path_set_pane_distance(paths, slot, 0.0f);
+  }
+  /* Leave on the side the new direction goes to (below for transmission). */
+  path_set_ray_origin(paths, slot, surface_spawn(s, ray_d, path_hit_t(paths, slot), bs.wi));
+  path_set_ray_tmin(paths, slot, 0.0f);
+  path_set_ray_dir(paths, slot, bs.wi);
+  path_set_ray_tmax(paths, slot, INFINITY);
+}
+
+#endif /* WP_INTEGRATOR_SAMPLE_BSDF_H */

@@ -1,0 +1,96 @@
+/* Hit resolution for one path: a miss adds the environment's radiance and ends the path; a hit
+ * adds the surface's emission and resolves the material into a Surface (bsdf.h). Emission and
+ * environment found here were found by BSDF sampling: they get the MIS weight against the pdf with
+ * which NEE would have chosen the same point (mis.h). Used by shade_surface.cl and the fused
+ * shade.cl. */
+#ifndef WP_INTEGRATOR_SHADE_SURFACE_H
+#define WP_INTEGRATOR_SHADE_SURFACE_H
+
+#include "stage.h"
+#include "lights.h"
+#include "mis.h"
+#include "surface.h"
+
+/* The fields shade_hit reads first, for the cache hints of the slot ahead. */
+static inline void shade_prefetch(Paths paths, uint slot) {
+  prefetch_path(paths, info, slot);
+  prefetch_path(paths, hit, slot);
+  prefetch_path(paths, ray_d, slot);
+  prefetch_path(paths, throughput, slot);
+  prefetch_path(paths, radiance, slot);
+  prefetch_path(paths, ray_o, slot);
+}
+
+#if WP_AOV
+/* Records the AOVs of the path in `slot` once: at the first surface whose BSDF is not delta lobes
+ * alone, so that mirrors and smooth glass show what they reflect or let through, as OIDN and OptiX
+ * want their albedo and normal inputs; or the background, for a path that leaves the scene first.
+ * The depth is set apart, by the camera ray. */
+static inline void aov_record(Paths paths, uint slot, float3 albedo, float3 normal) {
+  if (path_aov_recorded(paths, slot) != 0.0f) return;
+  path_set_aov_albedo(paths, slot, albedo);
+  path_set_aov_normal(paths, slot, normal);
+  path_set_aov_recorded(paths, slot, 1.0f);
+}
+#endif
+
+/* The hit of the path in `slot`: a miss adds the environment's radiance; a hit adds the surface's
+ * emission and resolves the material into *s. True when the path goes on to scatter at *s (not
+ * unlit, fewer than max_depth scattering events so far). */
+WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, uint slot,
+                           Surface* s) {
+  const float t = path_hit_t(paths, slot);
+  float3 beta = path_throughput(paths, slot);
+  const float bsdf_pdf = path_bsdf_pdf(paths, slot); /* 0: delta lobe or camera ray */
+  const float3 ray_d = path_ray_dir(paths, slot);
+  if (!(t < INFINITY)) {
+    const float w = mis_weight_bsdf_hit(bsdf_pdf, environment_light_pdf(scene, ray_d));
+    const float3 le = env_radiance(scene, ray_d);
+    path_set_radiance(paths, slot, path_radiance(paths, slot) + beta * le * w);
+#if WP_AOV
+    aov_record(paths, slot, clamp(le, 0.0f, 1.0f), (float3)(0.0f));
+#endif
+    return false;
+  }
+  const uint tri = path_hit_triangle(paths, slot);
+  const uint4 tv = scene->tri_vertices[tri];
+  bool front;
+  *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, &front);
+#if WP_AOV
+  if (path_bounce(paths, slot) == 0u) /* from the camera, panes passed on the way included */
+    path_set_aov_depth(paths, slot, t + path_pane_distance(paths, slot));
+  if (!bsdf_only_delta(s)) aov_record(paths, slot, s->color, s->ns);
+#endif
+#if WP_FEATURE_VOLUME
+  /* A ray that reaches the back of a volume travelled inside it: Beer-Lambert absorption with
+   * transmittance attenuationColor^(distance / attenuationDistance) (KHR_materials_volume). */
+  const float4 vol = scene->materials[tv.w].volume;
+  if (!front && (s->flags & WP_SURF_VOLUME) && vol.w < INFINITY) {
+    beta *= pow(vol.xyz, t / vol.w);
+    path_set_throughput(paths, slot, beta);
+  }
+#endif
+#if WP_FEATURE_EMISSION
+  if (front || (scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) {
+    const float3 le =
+        material_emission(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot));
+    if (max3(le) > 0.0f) {
+      /* Seen from the vertex that sampled the ray: panes passed on the way add their distance. */
+      const float dist = t + path_pane_distance(paths, slot);
+      const float p_light = triangle_light_pdf(scene, tri, dist, dot(s->ng, ray_d));
+      path_set_radiance(
+          paths, slot,
+          path_radiance(paths, slot) + beta * le * mis_weight_bsdf_hit(bsdf_pdf, p_light));
+    }
+  }
+#endif
+#if WP_FEATURE_UNLIT
+  if (s->flags & WP_SURF_UNLIT) { /* shows its colour as emitted radiance; nothing scatters */
+    path_set_radiance(paths, slot, path_radiance(paths, slot) + beta * s->color);
+    return false;
+  }
+#endif
+  return path_bounce(paths, slot) < launch.max_depth;
+}
+
+#endif /* WP_INTEGRATOR_SHADE_SURFACE_H */

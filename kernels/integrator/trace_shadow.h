@@ -1,0 +1,67 @@
+/* Shadow rays for one path: the radiance the shadow ray carries (path_shadow_radiance) times the
+ * transmittance along it is added to the path's radiance when the ray reaches its light.
+ *
+ * Without transmission in the program a shadow ray is an any-hit query: any surface occludes.
+ * With it, smooth thin-walled transmitters (delta transmission that does not bend the ray, like
+ * a window pane) let the ray pass with their transmittance (1 - F) x transmission x base colour
+ * (bsdf.h, microfacet_weights), so that punctual lights and the sun shine through them as
+ * they do in reality; BSDF sampling keeps its pdf through the same surfaces (sample_bsdf.h), so
+ * the MIS weights of both strategies still sum to 1. Such rays go from surface to surface with
+ * closest-hit queries, at most WP_SHADOW_MAX_LAYERS panes; a ray that meets more is taken as
+ * occluded (a bias only beyond that many panes in a row). Entry point: trace_shadow.cl. */
+#ifndef WP_INTEGRATOR_TRACE_SHADOW_H
+#define WP_INTEGRATOR_TRACE_SHADOW_H
+
+#include "stage.h"
+#include "material.h"
+#include "traverse.h"
+
+#define WP_SHADOW_MAX_LAYERS 16
+
+/* The fields trace_shadow_path reads and writes, for the cache hints of the slot ahead. */
+static inline void trace_shadow_prefetch(Paths paths, uint slot) {
+  prefetch_path(paths, shadow_o, slot);
+  prefetch_path(paths, shadow_d, slot);
+  prefetch_path(paths, shadow_l, slot);
+  prefetch_path(paths, radiance, slot);
+}
+
+WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch launch, uint slot) {
+  const float3 o = path_shadow_origin(paths, slot), d = path_shadow_dir(paths, slot);
+  const float tmax_light = path_shadow_tmax(paths, slot);
+  /* The random numbers of the bounce that made the ray (sample_lights.h). */
+  const uint key = rng_bits(path_rng_at(paths, slot, launch, path_shadow_bounce(paths, slot)),
+                            WP_DIM_ALPHA_SHADOW);
+#if WP_FEATURE_TRANSMISSION
+  const bool finite = tmax_light < INFINITY;
+  const float3 target = o + d * tmax_light; /* the end point of a ray of finite length */
+  float3 origin = o, transmit = (float3)(1.0f);
+  float tmax = tmax_light;
+  for (int layer = 0; layer <= WP_SHADOW_MAX_LAYERS; ++layer) {
+    const TraceRay ray = trace_ray(origin, d, 0.0f, key);
+    TraceHit hit;
+    if (!bvh_trace(scene, &ray, tmax, &hit, false)) {
+      path_set_radiance(paths, slot,
+                        path_radiance(paths, slot) + path_shadow_radiance(paths, slot) * transmit);
+      return;
+    }
+    const uint4 tv = scene->tri_vertices[hit.tri];
+    bool front;
+    const Surface s = resolve_surface(scene, tv, hit.u, hit.v, d, &front);
+    if (layer == WP_SHADOW_MAX_LAYERS || !bsdf_has_delta(&s) || !bsdf_transmits(&s) ||
+        bsdf_volume(&s))
+      return; /* an occluder */
+    transmit *= microfacet_weights(&s, fabs(dot(s.ns, d)), relative_ior(&s)).transmit;
+    if (!(max3(transmit) > 0.0f)) return;
+    origin = offset_origin(s.p, -s.ng, s.p_scale); /* s.ng faces the incoming ray */
+    if (finite) tmax = dot(target - origin, d);
+  }
+#else
+  const TraceRay ray = trace_ray(o, d, 0.0f, key);
+  TraceHit hit;
+  if (!bvh_trace(scene, &ray, tmax_light, &hit, true))
+    path_set_radiance(paths, slot, path_radiance(paths, slot) + path_shadow_radiance(paths, slot));
+#endif
+}
+
+#endif /* WP_INTEGRATOR_TRACE_SHADOW_H */
