@@ -6,6 +6,7 @@
 #include "host/device/device_scene.h"
 #include "host/scene/gltf_loader.h"
 #include "host/render/render.h"
+#include "host/util/error.h"
 
 namespace wp::bench {
 
@@ -74,6 +75,13 @@ const BounceCapture& SceneBench::bounce(int b) {
   return bounces_.at(static_cast<std::size_t>(b));
 }
 
+// The split pipeline's bounce step of `stage` (pipeline.h).
+const Step& bounce_step(Stage stage) {
+  for (const Step& step : split_pipeline().bounce)
+    if (step.stage == stage) return step;
+  throw Error(std::string(stage_name(stage)) + " is not a stage of the split pipeline's bounce");
+}
+
 StageJob SceneBench::stage_job(Stage stage, int b) {
   Wavefront& wf = stages();
   if (!in_bounce(stage)) b = 0;
@@ -88,12 +96,14 @@ StageJob SceneBench::stage_job(Stage stage, int b) {
     job.params = wf.launch_params(0, 0, wave_paths_);
     job.launch_items = job.items = wave_paths_;
   } else {
+    const Step& step = bounce_step(stage);
+    const auto length = [&](QueueRole q) {
+      return q == QueueRole::kSurface ? c.surfaces : q == QueueRole::kShadow ? c.shadows : c.rays;
+    };
     job.params = c.params;
-    // As run_bounce launches them: shadow rays over their count, the other stages over the rays.
-    job.launch_items = stage == Stage::kTraceShadow ? c.shadows : c.rays;
-    job.items = stage <= Stage::kShadeSurface  ? c.rays
-                : stage == Stage::kTraceShadow ? c.shadows
-                                               : c.surfaces;
+    job.items = length(step.in);  // the paths it works on
+    // As run_bounce launches it: over the bounce's rays, or exactly over its queue.
+    job.launch_items = step.size == LaunchSize::kQueueLength ? job.items : c.rays;
   }
   if (input_bounce_ == b && input_stage_ == stage) return job;
 
@@ -104,8 +114,12 @@ StageJob SceneBench::stage_job(Stage stage, int b) {
     dev::Launch p = c.params;
     for (std::uint32_t rays = c.rays; rays > 0;) rays = wf.run_bounce(p, rays);
   } else if (in_bounce(stage)) {
-    for (int s = static_cast<int>(Stage::kIntersectClosest); s < static_cast<int>(stage); ++s)
-      wf.launch_stage(static_cast<Stage>(s), c.rays, c.params);
+    // The bounce's steps before this one, each over the bounce's rays (an upper bound of every
+    // queue: the work-items past a queue's end return at once).
+    for (const Step& step : split_pipeline().bounce) {
+      if (step.stage == stage) break;
+      wf.launch_stage(step.stage, c.rays, c.params);
+    }
   }
   wf.finish();
   input_ = wf.snapshot();

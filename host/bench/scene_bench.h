@@ -18,7 +18,7 @@
 #include "host/bench/bench.h"
 #include "host/bench/embree_ref.h"
 #include "host/scene/scene.h"
-#include "host/render/stages.h"
+#include "host/render/pipeline.h"
 #include "host/render/wavefront.h"
 
 namespace wp::bench {

@@ -9,6 +9,7 @@
 #include "host/util/fnv1a.h"
 #include "host/scene/gltf_loader.h"
 #include "host/device/kernel_sources.h"
+#include "host/render/pipeline.h"
 
 namespace wp {
 
@@ -71,11 +72,8 @@ std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings
 
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
-    : rt_(runtime), settings_(settings) {
+    : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
   const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
-  // A wave holds up to 2^20 pixels of one sample; a smaller image gets several samples per wave,
-  // up to about kMultiSamplePaths paths (or the --wave-size asked for), so that its passes are
-  // not mostly kernel launches on a few rays (the last bounces).
   wave_size_ = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
   const std::size_t multi = settings.wave_size ? settings.wave_size : kMultiSamplePaths;
   samples_per_wave_ = std::max<std::size_t>(1, multi / wave_size_);
@@ -95,72 +93,73 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   path_state_ = path_state_layout(wave_paths(), settings.aov);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
-
-  SceneExtras extras;
-  extras.camera = pick_camera(scene, settings);
-  extras.background = settings.background;
-  extras.env = env;
-  extras.env_intensity = settings.env_intensity;
-  extras.env_rotation_degrees = settings.env_rotation;
-  extras.lights = &lights_;
-  const cl::Context& ctx = rt_.context();
   try {
-    // On a CPU device the kernels read the packed scene in place, which therefore stays here; a
-    // GPU gets its own copy, and the host's goes at the end of this block.
-    const bool in_place = !rt_.device().gpu;
-    PackedScene packed = pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings));
-    scene_ = upload_scene(ctx, packed, in_place);
-    scene_buffer_count_ = static_cast<int>(packed.buffers.size());
-    for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
-    // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
-    // buffer leaves the options as they were.
-    if (packed.buffer_map) {
-      char map[64];
-      std::snprintf(map, sizeof(map), " -D WP_SCENE_BUFFER_MAP=0x%llxul",
-                    static_cast<unsigned long long>(packed.buffer_map));
-      options_ += map;
-    }
-    if (in_place) packed_ = std::move(packed.buffers);
-    path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
-    queue_slots_ =
-        cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_paths() * sizeof(dev::uint));
-    counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
-    const std::size_t film_words = pixels * WP_FILM_WORDS(settings.aov);
-    film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
-    // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
-    // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every
-    // host write, sized to that write, so a fill (stored one pattern at a time) or a partial write
-    // leaves the entire buffer "uninitialised" to its --uninitialized check. The counters are 20
-    // bytes; the film's host zeros are as large as the copy film() reads back, and made once.
-    const std::vector<dev::uint> zero_counters(WP_COUNTER_COUNT, 0u);
-    rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, zero_counters.size() * sizeof(dev::uint),
-                                   zero_counters.data());
-    const std::vector<std::uint64_t> zero_film(film_words, 0);
-    rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, zero_film.size() * sizeof(std::uint64_t),
-                                   zero_film.data());
+    upload(scene, bvh);
+    allocate_state();
   } catch (const cl::Error& e) {
     rethrow_cl(e, "allocating device memory on " + rt_.device().name);
   }
+  build_program();
+}
 
+void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
+  SceneExtras extras;
+  extras.camera = pick_camera(scene, settings_);
+  extras.background = settings_.background;
+  extras.env = settings_.environment.get();
+  extras.env_intensity = settings_.env_intensity;
+  extras.env_rotation_degrees = settings_.env_rotation;
+  extras.lights = &lights_;
+  // On a CPU device the kernels read the packed scene in place, which therefore stays here; a GPU
+  // gets its own copy, and the host's goes at the end of this function.
+  const bool in_place = !rt_.device().gpu;
+  PackedScene packed = pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings_));
+  scene_ = upload_scene(rt_.context(), packed, in_place);
+  scene_buffer_count_ = static_cast<int>(packed.buffers.size());
+  for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
+  // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
+  // buffer leaves the options as they were.
+  if (packed.buffer_map) {
+    char map[64];
+    std::snprintf(map, sizeof(map), " -D WP_SCENE_BUFFER_MAP=0x%llxul",
+                  static_cast<unsigned long long>(packed.buffer_map));
+    options_ += map;
+  }
+  if (in_place) packed_ = std::move(packed.buffers);
+}
+
+void Wavefront::allocate_state() {
+  const cl::Context& ctx = rt_.context();
+  const std::size_t pixels = std::size_t(settings_.width) * std::size_t(settings_.height);
+  path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
+  queue_slots_ =
+      cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_paths() * sizeof(dev::uint));
+  counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
+  const std::size_t film_words = pixels * WP_FILM_WORDS(settings_.aov);
+  film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
+  // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
+  // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every host
+  // write, sized to that write, so a fill (stored one pattern at a time) or a partial write leaves
+  // the entire buffer "uninitialised" to its --uninitialized check. The counters are 20 bytes; the
+  // film's host zeros are as large as the copy film() reads back, and made once.
+  const std::vector<dev::uint> zero_counters(WP_COUNTER_COUNT, 0u);
+  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, zero_counters.size() * sizeof(dev::uint),
+                                 zero_counters.data());
+  const std::vector<std::uint64_t> zero_film(film_words, 0);
+  rt_.queue().enqueueWriteBuffer(film_, CL_TRUE, 0, zero_film.size() * sizeof(std::uint64_t),
+                                 zero_film.data());
+}
+
+// The program from the stages' sources, built (or taken from the kernel cache), and the kernels of
+// this pipeline made and primed; the other pipeline's are made only if a test or benchmark
+// launches one (kernel()).
+void Wavefront::build_program() {
   const auto build_start = std::chrono::steady_clock::now();
   const std::string source = program_source();
   source_digest_ = fnv1a64(source.data(), source.size());
-  program_ = rt_.build(source, options_, settings.kernel_cache_dir);
+  program_ = rt_.build(source, options_, settings_.kernel_cache_dir);
   kernel_cached_ = rt_.cached_build();
-  try {
-    for (int i = 0; i < kStageCount; ++i) {
-      cl::Kernel& k = kernels_.emplace_back(program_, kStageNames[i]);
-      cl_uint arg = set_scene_args(k, 0, scene_);
-      k.setArg(arg++, path_buf_);
-      k.setArg(arg++, path_state_.layout);
-      k.setArg(arg++, queue_slots_);
-      k.setArg(arg++, counters_);
-      launch_arg_ = arg++;
-      if (static_cast<Stage>(i) == Stage::kAccumulate) k.setArg(arg++, film_);
-    }
-  } catch (const cl::Error& e) {
-    rethrow_cl(e, "setting the kernels' arguments on " + rt_.device().name);
-  }
+  for (const Stage stage : pipeline_.stages()) kernel(stage);
   prime_kernels();
   try {
     for (const auto size : program_.getInfo<CL_PROGRAM_BINARY_SIZES>()) binary_bytes_ += size;
@@ -171,24 +170,40 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 }
 
+// Every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h), accumulate the film after them. All
+// but the Launch argument are set once, when the kernel is made.
+cl::Kernel& Wavefront::kernel(Stage stage) {
+  cl::Kernel& k = kernels_[static_cast<int>(stage)];
+  if (k()) return k;
+  try {
+    k = cl::Kernel(program_, stage_name(stage));
+    cl_uint arg = set_scene_args(k, 0, scene_);
+    k.setArg(arg++, path_buf_);
+    k.setArg(arg++, path_state_.layout);
+    k.setArg(arg++, queue_slots_);
+    k.setArg(arg++, counters_);
+    launch_arg_ = arg++;
+    if (stage == Stage::kAccumulate) k.setArg(arg++, film_);
+  } catch (const cl::Error& e) {
+    k = cl::Kernel();
+    rethrow_cl(e,
+               std::string("making the kernel ") + stage_name(stage) + " on " + rt_.device().name);
+  }
+  return k;
+}
+
 // Some implementations (PoCL) compile a kernel only at its first launch, for the work-group size
-// of that launch. One empty launch of each stage here makes that cost part of the build (where
-// kernel_build_seconds reports it) instead of the first sample pass.
+// of that launch. One empty launch of each of the pipeline's stages here makes that cost part of
+// the build (where kernel_build_seconds reports it) instead of the first sample pass; the other
+// pipeline's stages would add to the cold build for nothing.
 void Wavefront::prime_kernels() {
   dev::Launch p = launch_params(0, 0, 0);  // no paths: every work-item returns at once
   p.wave_pixels = 1;  // never divided by here (nothing gets past its early return), but not by 0
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
   try {
-    for (int i = 0; i < kStageCount; ++i) {
-      // Only the stages this pipeline runs: PoCL compiles a kernel at its first launch, and the
-      // other pipeline's kernels would add to the cold build for nothing.
-      const Stage s = static_cast<Stage>(i);
-      const bool split_only = s == Stage::kShadeSurface || s == Stage::kSampleLights ||
-                              s == Stage::kSampleBsdf || s == Stage::kRouletteCompact;
-      if (settings_.fused ? split_only : s == Stage::kShade) continue;
-      launch(s, static_cast<std::uint32_t>(local_size_), p);
-    }
+    for (const Stage stage : pipeline_.stages())
+      launch(stage, static_cast<std::uint32_t>(local_size_), p);
     rt_.queue().finish();
   } catch (const cl::Error& e) {
     rethrow_cl(e, "preparing the kernels on " + rt_.device().name);
@@ -200,11 +215,11 @@ cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch&
   if (items == 0) return cl::Event();
   const std::size_t local = local_size_;
   const std::size_t global = local ? (items + local - 1) / local * local : items;
-  cl::Kernel& kernel = kernels_[static_cast<int>(stage)];
+  cl::Kernel& k = kernel(stage);
   cl::Event event;
   try {
-    kernel.setArg(launch_arg_, params);
-    rt_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
+    k.setArg(launch_arg_, params);
+    rt_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global),
                                      local ? cl::NDRange(local) : cl::NullRange, nullptr, &event);
   } catch (const cl::Error& e) {
     rethrow_cl(e, std::string("launching ") + stage_name(stage));
@@ -247,7 +262,7 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   return p;
 }
 
-// One wave of paths through all bounces: the algorithm, one named call per stage.
+// One wave of paths through all bounces: the pipeline's start, bounces until no ray is left, end.
 void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
                          std::uint32_t samples) {
   dev::Launch p = start_wave(sample, first_pixel, count, samples);
@@ -255,48 +270,69 @@ void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::u
     rays_traced_ += rays;
     rays = run_bounce(p, rays);
   }
-  launch(Stage::kAccumulate, count, p);
+  run_step(pipeline_.end, p, 0);
 }
 
 dev::Launch Wavefront::start_wave(std::uint32_t sample, std::uint32_t first_pixel,
                                   std::uint32_t count, std::uint32_t samples) {
   dev::Launch p = launch_params(sample, first_pixel, count, samples);
-  p.queue_out = WP_QUEUE_RAY_A;
-  launch(Stage::kGenerateCameraRays, p.path_count, p);
+  // The camera rays go to the queue the first bounce reads.
   p.queue_in = WP_QUEUE_RAY_A;
+  p.queue_out = WP_QUEUE_RAY_A;
+  run_step(pipeline_.start, p, 0);
   p.queue_out = WP_QUEUE_RAY_B;
   return p;
+}
+
+std::uint32_t Wavefront::launch_items(const Step& step, const dev::Launch& p, std::uint32_t rays,
+                                      const QueueCounts* counts) const {
+  switch (step.size) {
+    case LaunchSize::kPaths:
+      return p.path_count;
+    case LaunchSize::kPixels:
+      return p.wave_pixels;
+    case LaunchSize::kRays:
+      return rays;
+    case LaunchSize::kQueueLength:
+      break;
+  }
+  if (!counts) throw Error("launch_items: the queue lengths were not read back");
+  return (*counts)[queue_index(step.in, p)];
+}
+
+void Wavefront::run_step(const Step& step, const dev::Launch& p, std::uint32_t rays,
+                         const QueueCounts* counts) {
+  launch(step.stage, launch_items(step, p, rays, counts), p);
+}
+
+Wavefront::QueueCounts Wavefront::read_queue_counts() {
+  QueueCounts counts{};
+  rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),
+                                counts.data());
+  return counts;
 }
 
 std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
   // Empty the surface, shadow and output queues. One write of all queue counters from offset 0,
   // with queue_in's rewritten to the `rays` it already holds, rather than fills of the three: any
   // partial host write makes Oclgrind 21.10 treat the whole counter buffer as uninitialised (see
-  // the constructor). The nonfinite counter after them is not written: it persists (so Oclgrind
+  // allocate_state). The nonfinite counter after them is not written: it persists (so Oclgrind
   // would call it uninitialised, were count_nonfinite ever reached; it must not be).
-  std::array<dev::uint, WP_QUEUE_COUNT> counters{};
-  counters[p.queue_in] = rays;
-  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counters.size() * sizeof(dev::uint),
-                                 counters.data());
-  launch(Stage::kIntersectClosest, rays, p);
-  if (settings_.fused) {
-    launch(Stage::kShade, rays, p);  // the queues it fills hold at most `rays` slots
-  } else {
-    launch(Stage::kShadeSurface, rays, p);
-    launch(Stage::kSampleLights, rays, p);  // the queues below hold at most `rays` slots
-    launch(Stage::kSampleBsdf, rays, p);
-    launch(Stage::kRouletteCompact, rays, p);
+  QueueCounts counts{};
+  counts[p.queue_in] = rays;
+  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),
+                                 counts.data());
+  // The bounce's one read-back, before the first step launched over an exact queue length; the
+  // steps from there on push to no queue (pipeline.h), so it holds the next bounce's ray count.
+  bool read = false;
+  for (const Step& step : pipeline_.bounce) {
+    if (step.size == LaunchSize::kQueueLength && !read) {
+      counts = read_queue_counts();
+      read = true;
+    }
+    run_step(step, p, rays, read ? &counts : nullptr);
   }
-  // The bounce's one read-back: the shadow queue's length and the next bounce's ray count. Shadow
-  // rays are traced last, over exactly their count: launched over `rays`, as the other stages
-  // are, the work-groups past the queue's end (most of them where few rays find a surface or few
-  // lights are visible) cost more than the rays did (README, "Shadow rays launched over their
-  // count"). trace_shadow reads nothing the stages before it change after sample_lights (the
-  // bounce for its random numbers travels with the ray).
-  std::array<dev::uint, WP_QUEUE_COUNT> counts{};
-  rt_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),
-                                counts.data());
-  launch(Stage::kTraceShadow, counts[WP_QUEUE_SHADOW], p);
+  if (!read) counts = read_queue_counts();
   const std::uint32_t next = counts[p.queue_out];
   std::swap(p.queue_in, p.queue_out);
   return next;

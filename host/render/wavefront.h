@@ -20,7 +20,7 @@
 #include "host/scene/scene.h"
 #include "host/device/scene_buffers.h"
 #include "host/device/scene_features.h"
-#include "host/render/stages.h"
+#include "host/render/pipeline.h"
 #include "kernels/shared/types.h"
 
 namespace wp {
@@ -44,16 +44,13 @@ struct RenderSettings {
   // Record albedo, normal and depth per sample too (AOVs, kernels/shared/film.h; FilmImages).
   bool aov = false;
   int max_depth = 12;  // scattering events per path at most
-  // Russian roulette from this many scattering events on (>= max_depth: off); 5 from the study in
-  // docs/accuracy.md ("Russian roulette"): less variance per sample than 3, the same work or less
-  // for a given error except in closed diffuse rooms (-11% there, +28% on a glossy floor).
+  // Russian roulette from this many scattering events on (>= max_depth: off); why 5: the study in
+  // docs/accuracy.md, "Russian roulette".
   int rr_depth = 5;
   // Roulette's throughput threshold: from rr_depth on, a path whose throughput (largest channel,
-  // kernels/roulette_compact.cl) m is below it survives with probability m / rr_threshold and
-  // then carries rr_threshold; at or above it, always. 1 is pbrt's rule (survival probability =
-  // throughput); 0.5 from the study in docs/accuracy.md ("the survival threshold"): 0.99-1.17
-  // times the efficiency of 1 on five scenes (most in closed rooms), next to no change on open
-  // scenes.
+  // kernels/integrator/roulette_compact.h) m is below it survives with probability
+  // m / rr_threshold and then carries rr_threshold; at or above it, always. 1 is pbrt's rule
+  // (survival probability = throughput); why 0.5: docs/accuracy.md, "the survival threshold".
   float rr_threshold = 0.5f;
   std::uint32_t seed = 0;      // the image is a pure function of (scene, settings, seed)
   glm::vec3 background{0.0f};  // radiance of escaped rays when there is no environment map
@@ -73,8 +70,8 @@ struct RenderSettings {
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
   // One fused kernel per bounce for everything at a hit (kernels/shade.cl), or the split stages
-  // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit.
-  // Fused by default: on PoCL it measured 10% faster on the Cornell box (README, "Fused shading").
+  // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit
+  // (pipeline.h). Fused by default: the faster on PoCL (docs/performance.md, "Fused shading").
   bool fused = true;
   // Cache hints for the path state ahead in each queue, on PoCL's CPU devices (kernels/features.h,
   // WP_PREFETCH); elsewhere nothing. The same image either way.
@@ -89,10 +86,9 @@ struct RenderSettings {
 };
 
 // The paths a wave of a small image holds by default (RenderSettings::wave_size): fewer waves
-// per sample, so fewer launches that trace only the last bounces' few rays. On the Lambertian
-// Cornell box, 128 x 128 x 256 spp on PoCL, waves of 2^14 paths took 2.15-2.32 s, 2^16 1.78-2.09 s,
-// 2^18 1.88-2.00 s, and in a second sweep 2^16 1.86-2.12 s, 2^18 1.98-2.02 s (README, "Waves of
-// several samples"). Equal here; 2^18 for a GPU, which keeps about that many threads in flight.
+// per sample, so fewer launches that trace only the last bounces' few rays. 2^16 to 2^18 measured
+// alike on PoCL (docs/performance.md, "Waves of several samples"); 2^18 for a GPU, which keeps
+// about that many threads in flight.
 constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 
 // The most bytes of one scene buffer on `device` with `settings`.
@@ -192,15 +188,32 @@ class Wavefront {
   bool kernel_cached() const { return kernel_cached_; }
 
  private:
+  using QueueCounts = std::array<dev::uint, WP_QUEUE_COUNT>;
+  // The constructor's steps: the packed scene to the device, the path state, queues, counters and
+  // film allocated, the program built and this pipeline's kernels made and primed.
+  void upload(const Scene& scene, const bvh::Bvh& bvh);
+  void allocate_state();
+  void build_program();
+  void prime_kernels();
+  // The kernel of `stage`, made with its arguments bound at its first use.
+  cl::Kernel& kernel(Stage stage);
+
   void run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
                 std::uint32_t samples);
+  // The work-items of `step` in the bounce `p` of `rays` rays; `counts`: the queue lengths read
+  // back (needed by LaunchSize::kQueueLength steps only).
+  std::uint32_t launch_items(const Step& step, const dev::Launch& p, std::uint32_t rays,
+                             const QueueCounts* counts) const;
+  void run_step(const Step& step, const dev::Launch& p, std::uint32_t rays,
+                const QueueCounts* counts = nullptr);
+  QueueCounts read_queue_counts();
   cl::Event launch(Stage stage, std::uint32_t items, const dev::Launch& params);
   std::uint32_t read_counter(std::uint32_t index);
   void collect_profile();
-  void prime_kernels();
 
   ClRuntime& rt_;
   RenderSettings settings_;
+  const Pipeline& pipeline_;  // the stages a wave runs (RenderSettings::fused)
   SceneFeatures features_;
   LightTable lights_;
   PathStateLayout path_state_;
@@ -222,10 +235,8 @@ class Wavefront {
   int scene_buffer_count_ = 0;
   cl::Buffer path_buf_, queue_slots_, counters_, film_;
   cl::Program program_;
-  // Every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h), accumulate the film after them.
-  // All but the Launch argument are set once, when the kernels are made.
-  std::vector<cl::Kernel> kernels_;  // indexed by Stage
-  cl_uint launch_arg_ = 0;           // the index of the Launch argument
+  std::array<cl::Kernel, kStageCount> kernels_;  // indexed by Stage; made by kernel()
+  cl_uint launch_arg_ = 0;                       // the index of the Launch argument
   std::vector<std::pair<Stage, cl::Event>> pending_events_;
   StageTimes times_;
 };
