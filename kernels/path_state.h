@@ -5,7 +5,7 @@
  *   path_bounce(paths, slot)             the lane's value
  *   path_set_bounce(paths, slot, value)  stores it, leaving the field's other lanes as they are
  *
- * These are the only code that indexes the path state (tests/test_kernel_sources.cpp checks that no
+ * These are the only code that indexes the path state (tests/test_kernel_tree.cpp checks that no
  * other kernel file does); prefetch_path (stage.h) takes a field's address, not a lane. */
 #ifndef WP_PATH_STATE_H
 #define WP_PATH_STATE_H

@@ -24,9 +24,8 @@
  * with the direction of the ray that found its surface, and each odd bounce's direction with the
  * one before it, at the cost of pairs that alone stratify a little less (dimensions 2-7 have
  * t-values up to 3 where dimensions 0, 1 have 0: each elementary interval of area 2^(t-k) holds
- * 2^t of 2^k samples). On the Lambertian Cornell box the image's relative MSE at the same samples
- * falls by 6% at 64 spp and 11% at 256 against the padded pattern, for 2% more time (README,
- * "Chained sample pairs").
+ * 2^t of 2^k samples). Less error for the same samples than the padded pattern, measured in
+ * docs/light-transport.md, "Chained sample pairs".
  *
  * Sobol, padded (WP_SAMPLER_SOBOL_PADDED): the same points, every pair in an order of its own
  * (the default pattern until 2026-11-25).
@@ -369,9 +368,9 @@ static inline PairSource rng_pair_source(Rng r, uint dim) {
 #define WP_PAIR_KEY_STEP 0x9e3779b9u
 
 /* One-dimensional: the scrambled van der Corput point of this group's shuffled sample index.
- * rng_get and rng_get2 are always inlined: left out of line (clang kept them so in the fused shade
- * kernel), they took 15% of a Cornell box render on PoCL; inlined, the fused kernel's time fell by
- * 7% (README, "Random numbers inlined"). */
+ * rng_get and rng_get2 are always inlined: clang kept them out of line in the fused shade kernel,
+ * where the calls cost a large share of a render on PoCL (docs/performance.md, "Random numbers
+ * inlined"). */
 static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
   const uint seed = rng_group_seed(r, dim);
   const uint index = rng_owen(r.sample, seed);
@@ -381,8 +380,7 @@ static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
 /* Two-dimensional group (dim, dim + 1): the scrambled point of a pair of Sobol' dimensions
  * (rng_pair_source) -- for the first two, the first (van der Corput) and the second (its digits
  * from rng_taylor_shift) -- in the two lanes of a uint2, each with its own key, as rng_bounce does
- * eight at a time (generate_camera_rays 0.027 s -> 0.022 s on the Cornell box, 128 x 128, 96 spp,
- * --profile, medians of 5). */
+ * eight at a time: the two chains run side by side in one vector register. */
 static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
   const PairSource src = rng_pair_source(r, dim);
   const uint seed = rng_group_seed(r, src.group);

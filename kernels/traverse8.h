@@ -58,8 +58,8 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
 #else
   (void)scene;
   /* Without alpha that rule picks the smallest t below the closest so far, the lowest lane among
-   * equals: found here without a branch per lane, the same hit (a branch per lane cost ~4% of
-   * intersect_closest on PoCL, README "How it works"). */
+   * equals: found here without a branch per lane, the same hit (a branch per lane was slower on PoCL:
+   * docs/performance.md, "Closest lane of a triangle block"). */
   ok &= t < hit->t;
   if (!any(ok)) return false;
   const float4 tm = select((float4)(INFINITY), t, ok);

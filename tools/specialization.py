@@ -4,8 +4,8 @@ features (--features scene) and with every feature (--features all).
 
 For each scene and build it records samples/s of the render, the program build time with a cold
 kernel cache (a fresh POCL_CACHE_DIR, so PoCL compiles everything) and with a warm one (the same
-cache again), and the size of the program binary. Prints a Markdown table (the README's
-specialisation table) with the machine, the device and this command line.
+cache again), and the size of the program binary. Prints a Markdown table (the
+specialisation table of docs/performance.md) with the machine, the device and this command line.
 
 Usage:
   python3 tools/specialization.py [--wavepath build/wavepath] [--spp 16] [--width 320]

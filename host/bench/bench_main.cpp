@@ -2,7 +2,7 @@
 // Embree on the same rays for the ray-tracing stages, plus end-to-end figures. Google Benchmark
 // drives it (--benchmark_filter, --benchmark_format=json, --benchmark_repetitions, ...); its own
 // options are taken out of the command line first. tools/bench_report.py turns the JSON into the
-// README's Performance section.
+// tables of docs/performance.md.
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

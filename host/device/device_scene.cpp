@@ -149,84 +149,127 @@ dev::Camera device_camera(const Camera& c, int width, int height) {
   return d;
 }
 
-PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
-                       std::uint64_t max_buffer) {
-  const std::size_t tris = scene.triangle_count();
-  const std::size_t verts = scene.positions.size();
+namespace {
+
+// One scene array: its size, the SceneDesc field that receives its offset, and what writes it in
+// place: a copy of an array that exists, or, for the per-triangle and per-vertex arrays, their
+// conversion straight into the buffer (no intermediate copy of gigabytes for tens of millions of
+// triangles).
+struct SceneArray {
+  std::uint64_t bytes;
+  dev::uint* offset;
+  std::function<void(unsigned char*)> write;
+};
+
+template <class Items>
+SceneArray copy_array(const Items& items, dev::uint& offset) {
+  const std::uint64_t bytes = items.size() * sizeof(items[0]);
+  const void* data = items.data();
+  return SceneArray{bytes, &offset, [data, bytes](unsigned char* to) {
+                      if (bytes) std::memcpy(to, data, bytes);
+                    }};
+}
+
+// `count` elements of type T, element i made by make(i).
+template <class Make>
+SceneArray convert_array(std::size_t count, dev::uint& offset, Make make) {
+  using T = decltype(make(std::size_t{0}));
+  return SceneArray{count * sizeof(T), &offset, [count, make](unsigned char* to) {
+                      T* out = reinterpret_cast<T*>(to);
+                      for (std::size_t i = 0; i < count; ++i) out[i] = make(i);
+                    }};
+}
+
+// The scene's materials, textures and images in their device form, which the arrays copy.
+struct DeviceMaterials {
   std::vector<dev::Material> materials;
-  for (const Material& m : scene.materials) materials.push_back(device_material(m));
   std::vector<dev::TextureRef> textures;
-  for (const TextureRef& t : scene.textures) textures.push_back(device_texture(t));
   std::vector<dev::TextureImage> images;
   std::vector<dev::uint> texels;
-  pack_images(scene, images, texels);
-  if (texels.size() > 0xffffffffu) throw Error(too_many_texels());
+};
 
-  PackedScene p;
-  dev::SceneDesc& d = p.desc;
-  // The arrays in kArrayNames' order, each with the SceneDesc field of its offset and what writes
-  // it in place: a copy of an array that exists, or, for the per-triangle and per-vertex arrays,
-  // their conversion straight into the buffer (no intermediate copy of gigabytes for tens of
-  // millions of triangles). The BVH is in the layout the program was built for (WP_BVH_WIDTH):
-  // the same two fields either way.
-  struct Array {
-    std::uint64_t bytes;
-    dev::uint* offset;
-    std::function<void(unsigned char*)> write;
-  };
-  const auto copy = [](const auto& items, dev::uint& offset) {
-    const std::uint64_t bytes = items.size() * sizeof(items[0]);
-    const void* data = items.data();
-    return Array{bytes, &offset, [data, bytes](unsigned char* to) {
-                   if (bytes) std::memcpy(to, data, bytes);
-                 }};
-  };
-  // `count` elements of type T, element i made by make(i).
-  const auto convert = [](std::size_t count, dev::uint& offset, auto make) {
-    using T = decltype(make(std::size_t{0}));
-    return Array{count * sizeof(T), &offset, [count, make](unsigned char* to) {
-                   T* out = reinterpret_cast<T*>(to);
-                   for (std::size_t i = 0; i < count; ++i) out[i] = make(i);
-                 }};
-  };
-  std::vector<Array> arrays = {
-      bvh.width == 8 ? copy(bvh.nodes8, d.bvh_nodes) : copy(bvh.nodes, d.bvh_nodes),
-      bvh.width == 8 ? copy(bvh.blocks, d.isect_tris) : copy(bvh.triangles, d.isect_tris),
-      convert(tris, d.tri_vertices,
-              [&](std::size_t i) {
-                return dev::uint4{scene.indices[3 * i], scene.indices[3 * i + 1],
-                                  scene.indices[3 * i + 2], scene.triangle_material[i]};
-              }),
-      convert(verts, d.positions, [&](std::size_t i) { return f4(scene.positions[i]); }),
-      convert(verts, d.normals, [&](std::size_t i) { return f4(scene.normals[i]); }),
-      convert(verts, d.tangents,
-              [&](std::size_t i) {
-                return i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
-              }),
-      convert(verts, d.uvs,
-              [&](std::size_t i) {
-                const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
-                const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
-                return dev::float4{uv0.x, uv0.y, uv1.x, uv1.y};
-              }),
-      convert(verts, d.colors,
-              [&](std::size_t i) {
-                return i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
-              }),
-      copy(materials, d.materials),
-      copy(textures, d.textures),
-      copy(images, d.images),
-      copy(texels, d.texels),
-      copy(x.lights->lights, d.lights),
-      copy(x.lights->alias, d.light_alias),
-      copy(x.lights->tri_light, d.tri_light)};
+DeviceMaterials device_materials(const Scene& scene) {
+  DeviceMaterials m;
+  for (const Material& material : scene.materials) m.materials.push_back(device_material(material));
+  for (const TextureRef& t : scene.textures) m.textures.push_back(device_texture(t));
+  pack_images(scene, m.images, m.texels);
+  if (m.texels.size() > 0xffffffffu) throw Error(too_many_texels());
+  return m;
+}
+
+// The per-triangle and per-vertex arrays, in kArrayNames' order from tri_vertices on.
+void add_geometry_arrays(const Scene& scene, dev::SceneDesc& d, std::vector<SceneArray>& arrays) {
+  const std::size_t tris = scene.triangle_count(), verts = scene.positions.size();
+  arrays.push_back(convert_array(tris, d.tri_vertices, [&](std::size_t i) {
+    return dev::uint4{scene.indices[3 * i], scene.indices[3 * i + 1], scene.indices[3 * i + 2],
+                      scene.triangle_material[i]};
+  }));
+  arrays.push_back(
+      convert_array(verts, d.positions, [&](std::size_t i) { return f4(scene.positions[i]); }));
+  arrays.push_back(
+      convert_array(verts, d.normals, [&](std::size_t i) { return f4(scene.normals[i]); }));
+  arrays.push_back(convert_array(verts, d.tangents, [&](std::size_t i) {
+    return i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
+  }));
+  arrays.push_back(convert_array(verts, d.uvs, [&](std::size_t i) {
+    const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
+    const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
+    return dev::float4{uv0.x, uv0.y, uv1.x, uv1.y};
+  }));
+  arrays.push_back(convert_array(verts, d.colors, [&](std::size_t i) {
+    return i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
+  }));
+}
+
+// Every array in kArrayNames' order. The BVH is in the layout the program was built for
+// (WP_BVH_WIDTH): the same two fields either way.
+std::vector<SceneArray> scene_arrays(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
+                                     const DeviceMaterials& m, dev::SceneDesc& d) {
+  std::vector<SceneArray> arrays;
+  arrays.push_back(bvh.width == 8 ? copy_array(bvh.nodes8, d.bvh_nodes)
+                                  : copy_array(bvh.nodes, d.bvh_nodes));
+  arrays.push_back(bvh.width == 8 ? copy_array(bvh.blocks, d.isect_tris)
+                                  : copy_array(bvh.triangles, d.isect_tris));
+  add_geometry_arrays(scene, d, arrays);
+  arrays.push_back(copy_array(m.materials, d.materials));
+  arrays.push_back(copy_array(m.textures, d.textures));
+  arrays.push_back(copy_array(m.images, d.images));
+  arrays.push_back(copy_array(m.texels, d.texels));
+  arrays.push_back(copy_array(x.lights->lights, d.lights));
+  arrays.push_back(copy_array(x.lights->alias, d.light_alias));
+  arrays.push_back(copy_array(x.lights->tri_light, d.tri_light));
   if (x.env) {
-    arrays.push_back(copy(x.env->texels, d.env_texels));
-    arrays.push_back(copy(x.env->marginal, d.env_marginal));
-    arrays.push_back(copy(x.env->conditional, d.env_conditional));
+    arrays.push_back(copy_array(x.env->texels, d.env_texels));
+    arrays.push_back(copy_array(x.env->marginal, d.env_marginal));
+    arrays.push_back(copy_array(x.env->conditional, d.env_conditional));
   }
+  return arrays;
+}
+
+// The SceneDesc's fields that are not array offsets: camera, background, environment, counts.
+void describe_scene(const Scene& scene, const SceneExtras& x, dev::SceneDesc& d) {
+  d.camera = x.camera;
+  d.background = f4(x.background);
+  const float rotation = x.env_rotation_degrees * 3.14159265358979f / 180.0f;
+  d.env_params = {x.env_intensity, std::cos(rotation), std::sin(rotation), 0.0f};
+  d.light_count = static_cast<dev::uint>(x.lights->lights.size());
+  d.env_light = x.lights->env_light;
+  d.triangle_count = static_cast<dev::uint>(scene.triangle_count());
+  if (x.env) {
+    d.env_width = static_cast<dev::uint>(x.env->width);
+    d.env_height = static_cast<dev::uint>(x.env->height);
+  }
+}
+
+}  // namespace
+
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
+                       std::uint64_t max_buffer) {
+  const DeviceMaterials materials = device_materials(scene);
+  PackedScene p;
+  const std::vector<SceneArray> arrays = scene_arrays(scene, bvh, x, materials, p.desc);
   std::vector<std::uint64_t> sizes;
-  for (const Array& a : arrays) sizes.push_back(a.bytes);
+  for (const SceneArray& a : arrays) sizes.push_back(a.bytes);
   const SceneLayout layout = plan_scene_layout(sizes, max_buffer);
   p.buffers.resize(layout.buffer_bytes.size());
   for (std::size_t i = 0; i < p.buffers.size(); ++i) p.buffers[i].resize(layout.buffer_bytes[i]);
@@ -236,18 +279,7 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
     *arrays[i].offset = static_cast<dev::uint>(place.offset / WP_SCENE_ALIGN);
   }
   p.buffer_map = layout.buffer_map();
-
-  d.camera = x.camera;
-  d.background = f4(x.background);
-  const float rotation = x.env_rotation_degrees * 3.14159265358979f / 180.0f;
-  d.env_params = {x.env_intensity, std::cos(rotation), std::sin(rotation), 0.0f};
-  d.light_count = static_cast<dev::uint>(x.lights->lights.size());
-  d.env_light = x.lights->env_light;
-  d.triangle_count = static_cast<dev::uint>(tris);
-  if (x.env) {
-    d.env_width = static_cast<dev::uint>(x.env->width);
-    d.env_height = static_cast<dev::uint>(x.env->height);
-  }
+  describe_scene(scene, x, p.desc);
   return p;
 }
 

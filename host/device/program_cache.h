@@ -1,7 +1,7 @@
 // A disk cache of built OpenCL programs (the device's binaries), so that a render of a scene whose
 // kernel variant was built before starts without compiling, or even preprocessing, the kernels:
 // PoCL, which caches compiled kernels itself, still preprocesses the whole source with clang to
-// find them (~23 ms of a 0.06 s start-up on the Cornell box); from a binary the build takes ~5 ms.
+// find them, most of a small render's start-up; from a binary it does not (docs/performance.md).
 //
 // An entry is keyed by a 64-bit hash of everything the binary depends on: the source, the build
 // options, and the device (platform name, device name and version, driver version). A missing,

@@ -129,136 +129,204 @@ int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
   return device.gpu ? 2 : 8;
 }
 
-Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
-                const RenderOptions& options) {
-  validate(settings);
-  const auto start = std::chrono::steady_clock::now();
+namespace {
+
+// The scene's BVH for `runtime`'s device, from the cache where allowed. A scene too large for the
+// device's buffers (device_scene.h) or its memory fails before the build (minutes for tens of
+// millions of triangles), with the least BVH its triangles need, and again before a fresh build is
+// cached, with the BVH built.
+bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
+                   const RenderOptions& options, const bvh::BuildOptions& bvh_options,
+                   bool* cached) {
   std::vector<std::uint32_t> flags;
-  bvh::BuildOptions bvh_options = options.bvh;
-  bvh_options.width = bvh_width(runtime.device(), settings);
-  bool cached = false;
-  // A scene too large for the device's buffers (device_scene.h) or its memory fails now, not
-  // after its BVH is built (minutes for tens of millions of triangles) and cached: first with the
-  // least BVH its triangles need, then, before it is cached, with the BVH built.
   const SceneCounts counts = scene_counts(scene, settings.environment.get());
   const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
   check_scene_memory(
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)
           .total_bytes(),
       runtime.device(), available_memory());
-  const bvh::Bvh bvh = bvh::build_cached(
-      bvh_input(scene, flags), bvh_options, options.bvh_cache ? cache_dir() : std::string(),
-      &cached, [&](const bvh::Bvh& built) {
+  return bvh::build_cached(
+      bvh_input(scene, flags), bvh_options, options.bvh_cache ? cache_dir() : std::string(), cached,
+      [&](const bvh::Bvh& built) {
         check_scene_memory(scene_layout(counts, bvh_bytes(built), max_buffer).total_bytes(),
                            runtime.device(), available_memory());
       });
+}
 
-  Wavefront wavefront(runtime, scene, bvh, settings);
-
-  Rendered out;
-  RenderReport& r = out.report;
+// What the set-up made: device, program, BVH, wave and scene sizes.
+void report_setup(RenderReport& r, const ClRuntime& runtime, const Scene& scene,
+                  const bvh::Bvh& bvh, bool bvh_cached, const Wavefront& wavefront) {
   r.device = runtime.device().name;
   r.features = wavefront.features().describe();
   r.build_options = wavefront.build_options();
   r.triangles = scene.triangle_count();
   r.bvh = bvh.stats;
-  r.bvh_cached = cached;
+  r.bvh_cached = bvh_cached;
   r.kernel_cached = wavefront.kernel_cached();
   r.kernel_build_seconds = wavefront.build_seconds();
   r.kernel_binary_bytes = wavefront.binary_bytes();
-  r.setup_seconds = since(start);
   r.wave_size = wavefront.wave_paths();
   r.bytes_per_path = wavefront.path_state().bytes_per_path;
   r.scene_bytes = wavefront.scene_bytes();
   r.scene_buffers = wavefront.scene_buffer_count();
+}
 
-  const std::uint32_t begin = static_cast<std::uint32_t>(settings.sample_begin);
-  const std::uint32_t end = begin + static_cast<std::uint32_t>(settings.spp);
+// The sample passes of one render: samples [begin, end) into the wavefront's film, pass after
+// pass, until every sample is rendered or a stop rule of RenderOptions ends them (deadline,
+// interruption, noise threshold); checkpoints between passes.
+class PassScheduler {
+ public:
+  PassScheduler(Wavefront& wavefront, const RenderSettings& settings, const RenderOptions& options,
+                FilmInfo info, RenderReport& report)
+      : wf_(wavefront),
+        settings_(settings),
+        options_(options),
+        info_(std::move(info)),
+        r_(report),
+        begin_(static_cast<std::uint32_t>(settings.sample_begin)),
+        end_(begin_ + static_cast<std::uint32_t>(settings.spp)),
+        next_(begin_),
+        next_check_(begin_ + kNoiseMinSamples) {}
+
+  // Continues `film` (RenderOptions::resume): the same render, samples [begin, k) with k <= end.
+  void resume(const Film& film) {
+    const FilmInfo& from = film.info();
+    FilmInfo want = info_;
+    want.sample_end = from.sample_end;
+    const std::string problem = film_identity_problem(from, want);
+    if (!problem.empty()) throw Error("the film to resume is of another render: " + problem);
+    if (from.sample_begin != begin_ || from.sample_end > end_)
+      throw Error("the film to resume holds samples " + std::to_string(from.sample_begin) + ":" +
+                  std::to_string(from.sample_end) + ", not the start of the requested " +
+                  std::to_string(begin_) + ":" + std::to_string(end_));
+    wf_.load_film(film);
+    next_ = from.sample_end;
+    resumed_nonfinite_ = from.nonfinite_samples;
+    info_.device = join_devices(from.device, info_.device);
+  }
+
+  // Renders passes until the samples are done or a stop rule holds (r.stop says which).
+  void run(std::chrono::steady_clock::time_point start) {
+    passes_start_ = std::chrono::steady_clock::now();
+    last_checkpoint_ = passes_start_;
+    while (next_ < end_) {
+      if (past_deadline()) {
+        r_.stop = StopReason::kTimeLimit;
+        break;
+      }
+      const std::uint32_t samples = next_pass_samples();
+      wf_.render_pass(next_, samples);
+      next_ += samples;
+      if (r_.passes++ == 0) r_.first_pass_seconds = since(start);
+      if (options_.progress)
+        options_.progress(int(next_ - begin_), settings_.spp, since(passes_start_), r_.passes);
+      if (options_.interrupted && options_.interrupted()) {
+        r_.stop = StopReason::kInterrupted;
+        break;
+      }
+      if (noise_below_threshold()) {
+        r_.stop = StopReason::kNoiseThreshold;
+        break;
+      }
+      if (options_.checkpoint && next_ < end_ &&
+          since(last_checkpoint_) >= options_.checkpoint_every) {
+        options_.checkpoint(film());
+        ++r_.checkpoints;
+        last_checkpoint_ = std::chrono::steady_clock::now();
+      }
+    }
+    r_.render_seconds = since(passes_start_);
+    r_.sample_end = next_;
+  }
+
+  // The film of samples [begin, next), read back from the device.
+  Film film() {
+    FilmInfo i = info_;
+    i.sample_end = next_;
+    i.nonfinite_samples = nonfinite();
+    return wf_.film(std::move(i));
+  }
+  std::uint64_t nonfinite() { return resumed_nonfinite_ + wf_.nonfinite_samples(); }
+  const std::string& device() const { return info_.device; }
+
+ private:
+  // No pass is started that would end, at the mean pass time so far, after the deadline; the
+  // first pass of a call always is.
+  bool past_deadline() const {
+    if (!options_.deadline || r_.passes == 0) return false;
+    const auto mean_pass = (std::chrono::steady_clock::now() - passes_start_) / r_.passes;
+    return std::chrono::steady_clock::now() + mean_pass > *options_.deadline;
+  }
+
+  // As many samples as a wave holds (several for a small image), but no further than the next
+  // noise check, so that the checks, and where they stop, do not depend on the wave size. The
+  // sample indices are absolute: the random numbers of sample s are the same in every part.
+  std::uint32_t next_pass_samples() const {
+    std::uint32_t samples =
+        std::min<std::uint32_t>(static_cast<std::uint32_t>(wf_.samples_per_wave()), end_ - next_);
+    if (options_.noise_threshold > 0 && next_check_ > next_)
+      samples = std::min(samples, next_check_ - next_);
+    return samples;
+  }
+
+  // At a noise check (RenderOptions::noise_threshold): whether the film's estimated relative error
+  // is at most the threshold; if not, the next check is where the error should fall to it.
+  bool noise_below_threshold() {
+    if (!(options_.noise_threshold > 0 && next_ < end_ && next_ >= next_check_)) return false;
+    const double e = relative_error(film().images());
+    if (e <= options_.noise_threshold) return true;
+    const double n = next_ - begin_;
+    const double ratio = e / options_.noise_threshold;
+    const double predicted = std::ceil(n * ratio * ratio);
+    next_check_ = begin_ + static_cast<std::uint32_t>(std::clamp(predicted, n + 1, 2 * n));
+    return false;
+  }
+
+  Wavefront& wf_;
+  const RenderSettings& settings_;
+  const RenderOptions& options_;
+  FilmInfo info_;
+  RenderReport& r_;
+  const std::uint32_t begin_, end_;
+  std::uint32_t next_;        // the next sample index to render
+  std::uint32_t next_check_;  // the sample count at which the noise threshold is checked next
+  std::uint64_t resumed_nonfinite_ = 0;
+  std::chrono::steady_clock::time_point passes_start_, last_checkpoint_;
+};
+
+}  // namespace
+
+Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
+                const RenderOptions& options) {
+  validate(settings);
+  const auto start = std::chrono::steady_clock::now();
+  bvh::BuildOptions bvh_options = options.bvh;
+  bvh_options.width = bvh_width(runtime.device(), settings);
+  bool cached = false;
+  const bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
+  Wavefront wavefront(runtime, scene, bvh, settings);
+
+  Rendered out;
+  RenderReport& r = out.report;
+  report_setup(r, runtime, scene, bvh, cached, wavefront);
+  r.setup_seconds = since(start);
   FilmInfo info;
   info.width = settings.width;
   info.height = settings.height;
   info.aov = settings.aov;
-  info.sample_begin = begin;
+  info.sample_begin = static_cast<std::uint32_t>(settings.sample_begin);
   info.key = render_key(scene, settings, bvh_options.width, bvh_options.spatial_splits,
                         wavefront.source_digest());
   info.device = r.device;
-  std::uint32_t next = begin;  // the next sample index to render
-  std::uint64_t resumed_nonfinite = 0;
-  if (options.resume) {
-    const FilmInfo& from = options.resume->info();
-    FilmInfo want = info;
-    want.sample_end = from.sample_end;
-    const std::string problem = film_identity_problem(from, want);
-    if (!problem.empty()) throw Error("the film to resume is of another render: " + problem);
-    if (from.sample_begin != begin || from.sample_end > end)
-      throw Error("the film to resume holds samples " + std::to_string(from.sample_begin) + ":" +
-                  std::to_string(from.sample_end) + ", not the start of the requested " +
-                  std::to_string(begin) + ":" + std::to_string(end));
-    wavefront.load_film(*options.resume);
-    next = from.sample_end;
-    resumed_nonfinite = from.nonfinite_samples;
-    info.device = join_devices(from.device, r.device);
-  }
-  // The film of samples [begin, next), read back from the device.
-  const auto film_so_far = [&] {
-    FilmInfo i = info;
-    i.sample_end = next;
-    i.nonfinite_samples = resumed_nonfinite + wavefront.nonfinite_samples();
-    return wavefront.film(std::move(i));
-  };
-
+  PassScheduler passes(wavefront, settings, options, std::move(info), r);
+  if (options.resume) passes.resume(*options.resume);
   if (options.passes_starting) options.passes_starting();
-  const auto passes_start = std::chrono::steady_clock::now();
-  auto last_checkpoint = passes_start;
-  // The sample count at which the noise threshold is checked next.
-  std::uint32_t next_check = begin + kNoiseMinSamples;
-  while (next < end) {
-    if (options.deadline && r.passes > 0) {
-      const auto mean_pass = (std::chrono::steady_clock::now() - passes_start) / r.passes;
-      if (std::chrono::steady_clock::now() + mean_pass > *options.deadline) {
-        r.stop = StopReason::kTimeLimit;
-        break;
-      }
-    }
-    // The absolute sample index: the random numbers of sample s are the same in every part.
-    // A pass renders as many samples as a wave holds (several for a small image), but stops at
-    // the next noise check, so that the checks, and where they stop, do not depend on it.
-    std::uint32_t samples = std::min<std::uint32_t>(
-        static_cast<std::uint32_t>(wavefront.samples_per_wave()), end - next);
-    if (options.noise_threshold > 0 && next_check > next)
-      samples = std::min(samples, next_check - next);
-    wavefront.render_pass(next, samples);
-    next += samples;
-    if (r.passes++ == 0) r.first_pass_seconds = since(start);
-    if (options.progress)
-      options.progress(int(next - begin), settings.spp, since(passes_start), r.passes);
-    if (options.interrupted && options.interrupted()) {
-      r.stop = StopReason::kInterrupted;
-      break;
-    }
-    if (options.noise_threshold > 0 && next < end && next >= next_check) {
-      const double e = relative_error(film_so_far().images());
-      if (e <= options.noise_threshold) {
-        r.stop = StopReason::kNoiseThreshold;
-        break;
-      }
-      const double n = next - begin;
-      const double predicted =
-          std::ceil(n * (e / options.noise_threshold) * (e / options.noise_threshold));
-      next_check = begin + static_cast<std::uint32_t>(std::clamp(predicted, n + 1, 2 * n));
-    }
-    if (options.checkpoint && next < end && since(last_checkpoint) >= options.checkpoint_every) {
-      options.checkpoint(film_so_far());
-      ++r.checkpoints;
-      last_checkpoint = std::chrono::steady_clock::now();
-    }
-  }
-  r.render_seconds = since(passes_start);
-  r.nonfinite_samples = resumed_nonfinite + wavefront.nonfinite_samples();
+  passes.run(start);
+
+  r.nonfinite_samples = passes.nonfinite();
   r.rays = wavefront.rays_traced();
   r.stages = wavefront.stage_times();
-  out.film = film_so_far();
-  r.sample_end = next;
+  out.film = passes.film();
   if (options.checkpoint) {
     options.checkpoint(out.film);
     ++r.checkpoints;

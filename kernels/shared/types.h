@@ -114,7 +114,7 @@ typedef struct Camera {
  * device's largest allocation (host/device/device_scene.h). Which buffer holds an array is fixed
  * when the program is built: WP_SCENE_BUFFER_MAP (kernels/scene.h), WP_SCENE_BUFFER_BITS per array
  * in SceneDesc's order, so every scene pointer is one kernel argument plus an offset (a buffer
- * index known only at run time made every kernel 12% slower on PoCL). The offset of each array in
+ * index known only at run time made every kernel slower on PoCL). The offset of each array in
  * its buffer is in SceneDesc, in units of WP_SCENE_ALIGN bytes: a uint reaches 256 GiB. */
 #define WP_SCENE_BUFFERS 8
 #define WP_SCENE_BUFFER_BITS 3
