@@ -9,5 +9,7 @@
 __kernel void accumulate(WP_STAGE_PARAMS, __global ulong* film) {
   WP_STAGE_BIND;
   const uint first = get_global_id(0);
-  if (first < launch.wave_pixels) accumulate_pixel(paths, queues, launch, film, first);
+  /* A wave without paths (the host's priming launch) has no pixel to read either. */
+  if (first < launch.wave_pixels && first < launch.path_count)
+    accumulate_pixel(paths, queues, launch, film, first);
 }

@@ -1,6 +1,6 @@
 // Runs test kernels (tests/kernels/*.cl, which include the project's kernel headers) on the default
-// OpenCL device, for tier-2 and tier-3 tests: device functions against host references, sampling
-// routines against their pdfs.
+// OpenCL device, for the kernel, sampling and energy tiers (docs/testing.md): device functions
+// against host references, sampling routines against their pdfs.
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// Tier 1: the BVH module, binary layout (the wide one: test_bvh8.cpp). Structure
+// unit tier: the BVH module, binary layout (the wide one: test_bvh8.cpp). Structure
 // (check_invariants on many meshes and options), the exact device layout, the build statistics,
 // bad input, and the CPU reference traversal against both a brute-force loop over the same
 // triangle test and Embree's own rtcIntersect1/rtcOccluded1.

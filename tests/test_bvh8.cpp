@@ -1,4 +1,4 @@
-// Tier 1: the BVH module, wide layout (BuildOptions::width = 8: BvhNode8 + TriBlock4). Structure
+// unit tier: the BVH module, wide layout (BuildOptions::width = 8: BvhNode8 + TriBlock4). Structure
 // (check_invariants on many meshes and options), the exact layout, the statistics, bad options,
 // oversized leaves, and the width-8 reference traversal against Embree's rtcIntersect1 /
 // rtcOccluded1, a brute-force loop over the same triangle test and the width-2 reference; its

@@ -18,7 +18,7 @@
 // needed 1.1 changes). It is added. A NaN or Inf anywhere on the way fails the test.
 #include <cmath>
 #include <cstdio>
-#include <functional>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -97,13 +97,19 @@ bool straight_through(const Material& m, double eta) {
   return !m.volume || std::fabs(eta - 1.0) < 1e-3;  // WP_ETA_STRAIGHT
 }
 
-// Midpoint rule over [0,1)^2 with n x n points.
-double midpoint2(int n, const std::function<double(double, double)>& f) {
+// Midpoint rule over [0,1)^2 with n x n points of f(row(x), column(y)): what depends on one
+// coordinate only is computed once per row or column (the values, and so the sums, are those of
+// evaluating everything at every point; this is ~10% of the test's time instead of ~30%).
+template <class Row, class Column, class F>
+double midpoint2(int n, const Row& row, const Column& column, const F& f) {
+  std::vector<decltype(column(0.0))> columns;
+  for (int j = 0; j < n; ++j) columns.push_back(column((j + 0.5) / n));
   double total = 0.0;
   for (int i = 0; i < n; ++i) {
-    double row = 0.0;
-    for (int j = 0; j < n; ++j) row += f((i + 0.5) / n, (j + 0.5) / n);
-    total += row;
+    const auto r = row((i + 0.5) / n);
+    double sum = 0.0;
+    for (int j = 0; j < n; ++j) sum += f(r, columns[std::size_t(j)]);
+    total += sum;
   }
   return total / (double(n) * n);
 }
@@ -111,9 +117,19 @@ double midpoint2(int n, const std::function<double(double, double)>& f) {
 struct Quad {
   double value, error;
 };
-Quad converge(int n, const std::function<double(double, double)>& f) {
-  const double fine = midpoint2(n, f), coarse = midpoint2(n / 2, f);
+template <class Row, class Column, class F>
+Quad converge(int n, const Row& row, const Column& column, const F& f) {
+  const double fine = midpoint2(n, row, column, f), coarse = midpoint2(n / 2, row, column, f);
   return {fine, 2.0 * std::fabs(fine - coarse)};
+}
+
+// The azimuth phi = 2 pi p's cosine and sine, the column of both integrals below.
+struct Azimuth {
+  double c, s;
+};
+Azimuth azimuth(double p) {
+  const double phi = 2.0 * kPi * p;
+  return {std::cos(phi), std::sin(phi)};
 }
 
 // The diffuse lobe: (1-m)(1-t) base / pi (1 - F(wo.h)) over the upper hemisphere, in
@@ -121,26 +137,29 @@ Quad converge(int n, const std::function<double(double, double)>& f) {
 Quad diffuse_albedo(const Material& m, V3 wo, double eta, int n) {
   const double k = (1.0 - m.metallic) * (1.0 - m.transmission) * m.grey;
   if (k == 0.0) return {0.0, 0.0};
-  return converge(n, [&](double s2, double p) {
-    const double sn = std::sqrt(s2), phi = 2.0 * kPi * p;
-    const V3 wi = {sn * std::cos(phi), sn * std::sin(phi), std::sqrt(1.0 - s2)};
-    const V3 sum = wo + wi;
-    const V3 h = (1.0 / std::sqrt(dot(sum, sum))) * sum;
-    return k * (1.0 - fresnel(std::max(dot(wo, h), 0.0), eta));
-  });
+  struct Row {
+    double sn, cos_i;
+  };
+  return converge(
+      n, [](double s2) { return Row{std::sqrt(s2), std::sqrt(1.0 - s2)}; }, azimuth,
+      [&](const Row& r, const Azimuth& a) {
+        const V3 wi = {r.sn * a.c, r.sn * a.s, r.cos_i};
+        const V3 sum = wo + wi;
+        const V3 h = (1.0 / std::sqrt(dot(sum, sum))) * sum;
+        return k * (1.0 - fresnel(std::max(dot(wo, h), 0.0), eta));
+      });
 }
 
 // The microfacet lobes over the microfacet normal h, in (w, phi / 2 pi) with
 // tan^2 theta_h = alpha^2 w / (1 - w): then D(h) cos theta_h d omega_h = dw d phi / 2 pi, and
 // f |cos_i| d omega_i = X D G2 (wo.h) / cos_o d omega_h for reflection and thin-walled
 // transmission (X = F or the transmittance), X D G2 (wo.h) / (cos_o eta^2) d omega_h for
-// refraction into a volume (Walter et al. 2007).
-double microfacet_integrand(const Material& m, V3 wo, double eta, double w, double p) {
+// refraction into a volume (Walter et al. 2007). `cos_h` and `sin_h` are theta_h's.
+double microfacet_integrand(const Material& m, V3 wo, double eta, double cos_h, double sin_h,
+                            const Azimuth& a) {
   const double alpha = m.roughness * m.roughness, cos_o = wo.z;
   const bool straight = m.volume && straight_through(m, eta);
-  const double tan_h = alpha * std::sqrt(w / (1.0 - w)), phi = 2.0 * kPi * p;
-  const double cos_h = 1.0 / std::sqrt(1.0 + tan_h * tan_h), sin_h = tan_h * cos_h;
-  const V3 h = {sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h};
+  const V3 h = {sin_h * a.c, sin_h * a.s, cos_h};
   const double o_h = dot(wo, h);
   if (o_h <= 0.0) return 0.0;
   const double measure = o_h / (cos_o * cos_h);  // times D cos_h d omega_h
@@ -168,10 +187,22 @@ double microfacet_integrand(const Material& m, V3 wo, double eta, double w, doub
 Quad microfacet_albedo(const Material& m, V3 wo, double eta, int n) {
   // w = 1 - (1 - x)^4: the GGX tail (tan^2 theta_h > T has probability alpha^2 / (alpha^2 + T),
   // all of it in w > T / (alpha^2 + T)) is resolved down to 1 - w ~ 1e-13, not cut at 1 / n.
-  return converge(n, [&](double x, double p) {
-    const double w = 1.0 - std::pow(1.0 - x, 4.0), dw_dx = 4.0 * std::pow(1.0 - x, 3.0);
-    return dw_dx * microfacet_integrand(m, wo, eta, w, p);
-  });
+  struct Row {
+    double dw_dx, cos_h, sin_h;
+  };
+  const double alpha = m.roughness * m.roughness;
+  return converge(
+      n,
+      [&](double x) {
+        const double w = 1.0 - std::pow(1.0 - x, 4.0), dw_dx = 4.0 * std::pow(1.0 - x, 3.0);
+        const double tan_h = alpha * std::sqrt(w / (1.0 - w));
+        const double cos_h = 1.0 / std::sqrt(1.0 + tan_h * tan_h);
+        return Row{dw_dx, cos_h, tan_h * cos_h};
+      },
+      azimuth,
+      [&](const Row& r, const Azimuth& a) {
+        return r.dw_dx * microfacet_integrand(m, wo, eta, r.cos_h, r.sin_h, a);
+      });
 }
 
 // Directional albedo for wo at cosine cos_o (x-z plane: the kernel's wo lies in that plane of

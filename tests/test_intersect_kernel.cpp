@@ -1,4 +1,4 @@
-// Tier 2: the ray-tracing stage kernels (intersect_closest, trace_shadow) against Embree's own
+// kernel tier: the ray-tracing stage kernels (intersect_closest, trace_shadow) against Embree's own
 // rtcIntersect1 / rtcOccluded1 on the same triangles, on PoCL.
 //
 // Expected agreement: the same hit/miss and the same triangle, t within 1e-4 relative plus the

@@ -1,5 +1,6 @@
-// Tier 4: the light transport as a whole - energy conservation, agreement of the sampling
-// strategies, and a closed-form area-light answer - on the default OpenCL device.
+// scene tier (its furnaces: energy): the light transport as a whole - energy conservation,
+// agreement of the sampling strategies, and a closed-form area-light answer - on the default
+// OpenCL device.
 //
 // Tolerances come from the renderer's own variance estimate: every render returns, per pixel,
 // the sample variance of its samples divided by the sample count (the variance of the pixel's

@@ -10,8 +10,11 @@
 # skipped (with a message) when its file is absent. A canary renders with one kernel made to read past the counter buffer and must be
 # reported, so that the test cannot pass because Oclgrind checked nothing.
 #
-# Usage: test_oclgrind.sh WAVEPATH SOURCE_DIR [ASSETS_DIR]
-#   ASSETS_DIR defaults to $WAVEPATH_ASSETS, else SOURCE_DIR/../shared/assets.
+# Usage: test_oclgrind.sh WAVEPATH SOURCE_DIR [ASSETS_DIR [CASE...]]
+#        test_oclgrind.sh --list
+#   ASSETS_DIR defaults to $WAVEPATH_ASSETS, else SOURCE_DIR/../shared/assets. With CASE names,
+#   only those cases run (ctest runs each case as its own test, oclgrind_NAME, side by side:
+#   Oclgrind simulates on one thread); --list prints every case's name, one a line.
 #
 # Oclgrind 21.10 notes: it cannot run the kernels built with LLVM's optimisations (a fatal
 # "Undefined external function: llvm.experimental.noalias.scope.decl"), hence -cl-opt-disable
@@ -19,13 +22,70 @@
 # `oclgrind`, and reports itself as a GPU, so the BVH layout is chosen per case explicitly.
 set -uo pipefail
 
+# The cases, in the order they run; case_table prints "NAME" lines for --list, or runs the
+# selected ones through check (and canary).
+case_table() {
+  local scenes=$src/scenes models=$assets/models
+  # In the repository: both BVH layouts, all features, several waves of several work-groups (and
+  # a partial last group), an environment map, glass and mirrors, punctual lights, degenerate
+  # triangles, scenes split over several scene buffers (3 each, --json's scene_buffers), AOVs,
+  # waves of several samples, the split stage kernels (the fused shade kernel is the default) and
+  # the independent sampler.
+  check cornell_bvh2 "$scenes/cornell_box.gltf" --bvh-width 2
+  check cornell_bvh8_all "$scenes/cornell_box.gltf" --bvh-width 8 --features all --local-size 16 \
+    --pipeline split
+  check point_waves "$scenes/cornell_box_point.gltf" --bvh-width 8 --spp 2 --wave-size 20 \
+    --local-size 16
+  check cornell_samples_per_wave "$scenes/cornell_box.gltf" --bvh-width 8 --spp 3 --wave-size 100 \
+    --pipeline split
+  check cornell_split "$scenes/cornell_box.gltf" --bvh-width 8 --scene-buffer-kib 4
+  check env_sun_split "$scenes/failure/env_sun.gltf" --env "$scenes/failure/env_sun.hdr" \
+    --bvh-width 2 --scene-buffer-kib 2048
+  check caustics "$scenes/failure/caustics.gltf" --bvh-width 8 --aov albedo,normal,depth
+  check caustics_split "$scenes/failure/caustics.gltf" --bvh-width 2 --aov albedo,normal,depth \
+    --pipeline split
+  check punctual "$scenes/failure/punctual.gltf" --bvh-width 8 --features all --pipeline split
+  check punctual_fused "$scenes/failure/punctual.gltf" --bvh-width 2 --features all \
+    --pipeline fused --sampler independent
+  check degenerate "$scenes/failure/degenerate.gltf" --bvh-width 2 --local-size 16
+
+  # Shared assets (small ones; see ../shared/assets/README.md for what each exercises).
+  check textures_alpha_mask "$models/TextureEncodingTest/TextureEncodingTest.glb" --bvh-width 8
+  check alpha_blend_spot "$models/ShadowsSpot/shadows-spot.gltf" --bvh-width 2
+  check transmission_volume "$models/AttenuationTest/AttenuationTest.glb" --bvh-width 2 \
+    --features all
+  check glass_alpha_normal_maps "$models/GlassBrokenWindow/GlassBrokenWindow.glb" --bvh-width 8
+  check texture_samplers "$models/TextureSettingsTest/TextureSettingsTest.glb" --bvh-width 2
+  # (check skips a case whose scene, or environment map from the assets, is absent.)
+  check env_map_textured "$models/BoxTextured/BoxTextured.glb" \
+    --env "$assets/env/studio_small_03_1k.hdr" --bvh-width 8
+
+  canary
+}
+
+if [[ ${1:-} == --list ]]; then
+  check() { echo "$1"; }
+  canary() { echo canary; }
+  src=. assets=.
+  case_table
+  exit 0
+fi
 if (($# < 2)); then
-  echo "usage: $0 WAVEPATH SOURCE_DIR [ASSETS_DIR]" >&2
+  echo "usage: $0 WAVEPATH SOURCE_DIR [ASSETS_DIR [CASE...]] | --list" >&2
   exit 2
 fi
 wavepath=$1
 src=$2
 assets=${3:-${WAVEPATH_ASSETS:-$src/../shared/assets}}
+selected=("${@:4}")
+
+# selected NAME: whether case NAME runs (every case when none is named).
+is_selected() {
+  ((${#selected[@]} == 0)) && return 0
+  local s
+  for s in "${selected[@]}"; do [[ $s == "$1" ]] && return 0; done
+  return 1
+}
 
 if ! command -v oclgrind >/dev/null; then
   echo "FAIL: oclgrind not found (tools/setup.sh installs Debian's oclgrind package)" >&2
@@ -48,31 +108,48 @@ summarise() {
     "$(grep -c 'OCLGRIND FATAL ERROR' "$log")"
 }
 
-# run_case NAME SCENE [wavepath render options...]: one 8x6 render under Oclgrind, 1 spp unless the
-# options say otherwise. Sets case_log, case_out and case_rc; prints nothing.
+# run_case NAME SCENE [wavepath render options...]: one 8x6 render under Oclgrind, 1 spp in one
+# wave of its 48 paths unless the options say otherwise. Sets case_log, case_out and case_rc;
+# prints nothing. (The default wave, sized for large images, holds ~260,000 paths: Oclgrind then
+# tracks ~60 MB of path state that 48 paths never touch, 10x the time and 3 GB of
+# memory for nothing, and an index past the live paths would still land inside the buffers.)
 run_case() {
   local name=$1 scene=$2
   shift 2
   case_log=$work/$name.log
   case_out=$work/$name.out
   rm -f "$case_log"
-  local spp=(--spp 1) arg
-  for arg in "$@"; do [[ $arg == --spp ]] && spp=(); done
+  local spp=(--spp 1) wave=(--wave-size 48) arg
+  for arg in "$@"; do
+    [[ $arg == --spp ]] && spp=() && wave=()
+    [[ $arg == --wave-size ]] && wave=()
+  done
   timeout -k 10 300 oclgrind --build-options -cl-opt-disable --check-api --data-races --uninitialized \
     --max-errors 50 --log "$case_log" \
-    "$wavepath" render "$scene" --device Oclgrind --width 8 --height 6 "${spp[@]}" --no-bvh-cache \
-    --json -o "$work/$name.pfm" "$@" >"$case_out" 2>&1
+    "$wavepath" render "$scene" --device Oclgrind --width 8 --height 6 "${spp[@]}" "${wave[@]}" \
+    --no-bvh-cache --json -o "$work/$name.pfm" "$@" >"$case_out" 2>&1
   case_rc=$?
 }
 
 # check NAME SCENE [options...]: a case that must run cleanly.
 check() {
-  local name=$1 scene=$2
+  local name=$1 scene=$2 arg
+  is_selected "$name" || return 0
+  matched=$((matched + 1))
   if [[ ! -f $scene ]]; then
     echo "SKIP $name: $scene not found"
     skipped=$((skipped + 1))
     return
   fi
+  local previous=""
+  for arg in "$@"; do  # an environment map from the shared assets may be absent too
+    if [[ $previous == --env && $arg == "$assets"/* && ! -f $arg ]]; then
+      echo "SKIP $name: $arg not found"
+      skipped=$((skipped + 1))
+      return
+    fi
+    previous=$arg
+  done
   local start=$SECONDS
   run_case "$@"
   local seconds=$((SECONDS - start)) problem=""
@@ -105,6 +182,8 @@ check() {
 # lies past the buffer must not steer the kernel (a garbage queue length once sent traversal into
 # garbage slots for minutes).
 canary() {
+  is_selected canary || return 0
+  matched=$((matched + 1))
   local dir=$work/canary_kernels
   mkdir -p "$dir"
   sed 's/if (index >= qs\.counters\[q\]) return false;/if (index >= qs.counters[q] + 0u * qs.counters[q + WP_COUNTER_COUNT]) return false;/' \
@@ -129,48 +208,12 @@ canary() {
   fi
 }
 
-scenes=$src/scenes
-models=$assets/models
-
-# In the repository: both BVH layouts, all features, several waves of several work-groups (and a
-# partial last group), an environment map, glass and mirrors, punctual lights, degenerate
-# triangles, scenes split over several scene buffers (3 each, --json's scene_buffers), AOVs,
-# waves of several samples, the split stage kernels (the fused shade kernel is the default) and
-# the independent sampler.
-check cornell_bvh2 "$scenes/cornell_box.gltf" --bvh-width 2
-check cornell_bvh8_all "$scenes/cornell_box.gltf" --bvh-width 8 --features all --local-size 16 \
-  --pipeline split
-check point_waves "$scenes/cornell_box_point.gltf" --bvh-width 8 --spp 2 --wave-size 20 \
-  --local-size 16
-check cornell_samples_per_wave "$scenes/cornell_box.gltf" --bvh-width 8 --spp 3 --wave-size 100 \
-  --pipeline split
-check cornell_split "$scenes/cornell_box.gltf" --bvh-width 8 --scene-buffer-kib 4
-check env_sun_split "$scenes/failure/env_sun.gltf" --env "$scenes/failure/env_sun.hdr" \
-  --bvh-width 2 --scene-buffer-kib 2048
-check caustics "$scenes/failure/caustics.gltf" --bvh-width 8 --aov albedo,normal,depth
-check caustics_split "$scenes/failure/caustics.gltf" --bvh-width 2 --aov albedo,normal,depth \
-  --pipeline split
-check punctual "$scenes/failure/punctual.gltf" --bvh-width 8 --features all --pipeline split
-check punctual_fused "$scenes/failure/punctual.gltf" --bvh-width 2 --features all \
-  --pipeline fused --sampler independent
-check degenerate "$scenes/failure/degenerate.gltf" --bvh-width 2 --local-size 16
-
-# Shared assets (small ones; see ../shared/assets/README.md for what each exercises).
-check textures_alpha_mask "$models/TextureEncodingTest/TextureEncodingTest.glb" --bvh-width 8
-check alpha_blend_spot "$models/ShadowsSpot/shadows-spot.gltf" --bvh-width 2
-check transmission_volume "$models/AttenuationTest/AttenuationTest.glb" --bvh-width 2 \
-  --features all
-check glass_alpha_normal_maps "$models/GlassBrokenWindow/GlassBrokenWindow.glb" --bvh-width 8
-check texture_samplers "$models/TextureSettingsTest/TextureSettingsTest.glb" --bvh-width 2
-if [[ -f $assets/env/studio_small_03_1k.hdr ]]; then
-  check env_map_textured "$models/BoxTextured/BoxTextured.glb" \
-    --env "$assets/env/studio_small_03_1k.hdr" --bvh-width 8
-else
-  echo "SKIP env_map_textured: $assets/env/studio_small_03_1k.hdr not found"
-  skipped=$((skipped + 1))
+matched=0
+case_table
+if ((matched != ${#selected[@]} && ${#selected[@]} > 0)); then
+  echo "FAIL: no such case among ${selected[*]} (test_oclgrind.sh --list names them)"
+  failures=$((failures + 1))
 fi
-
-canary
 
 echo "oclgrind: $ran run, $skipped skipped, $failures failed"
 ((failures == 0))

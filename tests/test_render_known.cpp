@@ -1,4 +1,4 @@
-// Tier 4: whole-pipeline renders with answers known in closed form, computed here, plus
+// scene tier: whole-pipeline renders with answers known in closed form, computed here, plus
 // determinism. All on the default OpenCL device (PoCL in CI).
 //
 // Every known-answer scene here has no randomness but the pixel jitter (box filter): one bounce

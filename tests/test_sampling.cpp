@@ -1,4 +1,4 @@
-// Tier 3: every sampling routine against its own density, on the OpenCL device (PoCL in CI).
+// sampling tier: every sampling routine against its own density, on the OpenCL device (PoCL in CI).
 //
 // Per configuration, tests/kernels/sampling_kernels.cl draws kSamples directions and integrates
 // the density that the routine's eval side gives (cosine_hemisphere_pdf, ggx_reflection_pdf,

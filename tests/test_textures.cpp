@@ -1,4 +1,4 @@
-// Tier 2: texture sampling (kernels/textures.h), alpha (kernels/alpha.h) and material resolution
+// kernel tier: texture sampling (kernels/textures.h), alpha (kernels/alpha.h) and material resolution
 // (kernels/material.h) on the OpenCL device, against host references written here from the glTF
 // 2.0 specification (its samplers follow OpenGL: texel centres at (i + 0.5) / size, wrap modes on
 // texel indices, NEAREST or bilinear LINEAR magnification) and the sRGB standard, over scenes

@@ -13,8 +13,12 @@
 #   build-fuzz/fuzz_gltf build-fuzz/findings/fuzz_gltf/crash-...
 # (WP_FUZZ_VERBOSE=1 prints the wp::Error an input gives).
 #
-#   tools/fuzz.sh [SECONDS]   build if needed, fuzz each target SECONDS
-#   tools/fuzz.sh --check     exit 0 when clang++ can build libFuzzer targets, else 1 (silent)
+#   tools/fuzz.sh [SECONDS [TARGET...]]   build if needed, fuzz each target (default: both) SECONDS
+#   tools/fuzz.sh --build                 only build the targets and the seeds
+#   tools/fuzz.sh --run SECONDS TARGET... fuzz without building (after --build; ctest's fuzz tier
+#                                         runs the targets side by side this way, tests/CMakeLists.txt)
+#   tools/fuzz.sh --check                 exit 0 when clang++ can build libFuzzer targets, else 1
+#                                         (silent)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,23 +38,48 @@ if [[ ${1:-} == --check ]]; then
   if have_libfuzzer; then exit 0; fi
   exit 1
 fi
-seconds=${1:-60}
-if ! [[ $seconds =~ ^[0-9]+$ ]] || ((seconds == 0)); then
-  echo "usage: tools/fuzz.sh [SECONDS] | --check" >&2
+build_step=1 run_step=1
+case ${1:-} in
+  --build) run_step=0 && shift ;;
+  --run) build_step=0 && shift ;;
+esac
+usage() {
+  echo "usage: tools/fuzz.sh [SECONDS [TARGET...]] | --build | --run SECONDS TARGET... | --check" >&2
   exit 2
+}
+seconds=60
+targets=(fuzz_gltf fuzz_environment)
+if ((run_step)); then
+  seconds=${1:-60}
+  if ! [[ $seconds =~ ^[0-9]+$ ]] || ((seconds == 0)); then usage; fi
+  (($# > 1)) && targets=("${@:2}")
+  ((build_step || $# > 1)) || usage
+  for t in "${targets[@]}"; do
+    [[ $t == fuzz_gltf || $t == fuzz_environment ]] || usage
+  done
+elif (($# > 0)); then
+  usage
 fi
-if ! have_libfuzzer; then
-  echo "wavepath fuzz: clang++ with libFuzzer is missing (apt-get install clang libclang-rt-14-dev)" >&2
-  exit 1
-fi
-
 build=build-fuzz
 assets=${WAVEPATH_ASSETS:-../shared/assets}
-jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S tests/fuzz -B "$build" -DCMAKE_CXX_COMPILER=clang++ >/dev/null
-cmake --build "$build" -j"$jobs" >/dev/null
-rm -rf "$build/seeds"
-python3 tests/fuzz/make_seeds.py "$build/seeds" "$assets"
+if ((build_step)); then
+  if ! have_libfuzzer; then
+    echo "wavepath fuzz: clang++ with libFuzzer is missing (apt-get install clang libclang-rt-14-dev)" >&2
+    exit 1
+  fi
+  jobs=$(nproc 2>/dev/null || echo 2)
+  cmake -S tests/fuzz -B "$build" -DCMAKE_CXX_COMPILER=clang++ >/dev/null
+  cmake --build "$build" -j"$jobs" >/dev/null
+  rm -rf "$build/seeds"
+  python3 tests/fuzz/make_seeds.py "$build/seeds" "$assets"
+fi
+((run_step)) || exit 0
+for t in "${targets[@]}"; do
+  if [[ ! -x $build/$t || ! -d $build/seeds ]]; then
+    echo "wavepath fuzz: $build/$t or its seeds missing (tools/fuzz.sh --build)" >&2
+    exit 1
+  fi
+done
 
 # Each input is written to a file for the loaders; on tmpfs when possible, removed at the end.
 scratch=$(mktemp -d "$([[ -d /dev/shm ]] && echo /dev/shm || echo /tmp)/wavepath-fuzz.XXXXXX")
@@ -79,9 +108,13 @@ fuzz() {
   return $status
 }
 
+# Each target's seed folder, dictionary and largest input.
+declare -A spec=([fuzz_gltf]="gltf gltf.dict 65536" [fuzz_environment]="environment environment.dict 16384")
 failed=0
-fuzz fuzz_gltf gltf gltf.dict 65536 || failed=1
-fuzz fuzz_environment environment environment.dict 16384 || failed=1
+for t in "${targets[@]}"; do
+  # shellcheck disable=SC2086 # the spec is three words
+  fuzz "$t" ${spec[$t]} || failed=1
+done
 if ((failed)); then
   echo "wavepath fuzz: findings saved under $build/findings/" >&2
   exit 1

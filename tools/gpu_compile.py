@@ -26,7 +26,7 @@ so registers and spills went unchecked.
 
   tools/gpu_compile.py                       everything, a table of variant x kernel
   tools/gpu_compile.py --scenes scenes/cornell_box.gltf --no-aov --markdown
-                                             the README's table
+                                             the table of docs/performance.md
   tools/gpu_compile.py --quick               all features only (no wavepath runs)
 Environment: PTXAS (default: ptxas on PATH, else /usr/local/cuda/bin/ptxas), WP_LIBCLC_DIR
 (default: /usr/lib/clc, Debian's libclc-14), CLANG (default: clang).

@@ -198,7 +198,7 @@ cl::Kernel& Wavefront::kernel(Stage stage) {
 // pipeline's stages would add to the cold build for nothing.
 void Wavefront::prime_kernels() {
   dev::Launch p = launch_params(0, 0, 0);  // no paths: every work-item returns at once
-  p.wave_pixels = 1;  // never divided by here (nothing gets past its early return), but not by 0
+  p.wave_pixels = 1;  // never divided by here (no work-item gets past path_count 0), but not by 0
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
   try {

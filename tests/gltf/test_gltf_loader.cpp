@@ -1,0 +1,208 @@
+// glTF loader, gltf_loader.cpp: the file (.gltf, .glb), the scene and its node graph, extensions,
+// the framing camera, malformed files (wp::Error naming the file and the cause, never a crash).
+// Shared fixture: tests/gltf/gltf_files.h.
+#include "tests/gltf/gltf_files.h"
+
+namespace {
+
+using namespace wp::test::gltf_files;  // NOLINT(google-build-using-namespace)
+
+// temp_dir() is removed after the tests (once per executable, so here only).
+[[maybe_unused]] auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new TempCleanup);
+
+TEST(GltfLoader, GlbMatchesGltf) {
+  const wp::Scene s = wp::load_gltf(hierarchy().write_glb("hierarchy.glb"));
+  check_hierarchy(s);
+  // Content decides the format, not the extension.
+  check_hierarchy(wp::load_gltf(hierarchy().write_glb("binary_named.gltf")));
+}
+
+// "scene": 1 picks the second scene; without "scene", scene 0 is used.
+TEST(GltfLoader, DefaultScene) {
+  Gltf g = one_triangle("");
+  g.node("\"mesh\":0,\"translation\":[10,0,0]");
+  g.scenes = R"("scene":1,"scenes":[{"nodes":[0]},{"nodes":[1]}])";
+  EXPECT_TRUE(near(wp::load_gltf(g.write("scene1.gltf")).bounds_lo, {10, 0, 0}));
+  g.scenes = R"("scenes":[{"nodes":[0]},{"nodes":[1]}])";
+  EXPECT_TRUE(near(wp::load_gltf(g.write("scene0.gltf")).bounds_lo, {0, 0, 0}));
+}
+
+// Only unsupported extensions warn; an image no material uses is never decoded (this one could
+// not be).
+TEST(GltfLoader, ExtensionWarnings) {
+  Gltf g = one_triangle("");
+  g.top =
+      R"("extensionsUsed":["KHR_materials_sheen","KHR_materials_volume","KHR_texture_transform",)"
+      R"("KHR_materials_unlit"],"textures":[{"source":0}],)"
+      R"("images":[{"uri":"data:image/png;base64,AAAA"}])";
+  const wp::Scene s = wp::load_gltf(g.write("warn.gltf"));
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("KHR_materials_sheen"), std::string::npos) << s.warnings[0];
+  EXPECT_TRUE(s.images.empty());
+}
+
+TEST(GltfLoader, FramingCamera) {
+  wp::Scene s;
+  s.bounds_lo = vec3(-1, 0, -3);
+  s.bounds_hi = vec3(3, 2, 1);
+  for (const float aspect : {1.0f, 0.5f, 2.0f}) {
+    const wp::Camera c = wp::framing_camera(s, aspect);
+    EXPECT_EQ(c.type, wp::CameraType::kPerspective);
+    EXPECT_NEAR(c.yfov, kPi / 4, 1e-6f);
+    EXPECT_LT(c.forward.z, -0.9f);  // along -Z ...
+    EXPECT_LT(c.forward.y, 0.0f);   // ... slightly from above
+    EXPECT_NEAR(glm::dot(c.forward, c.up), 0.0f, 1e-6f);
+    const vec3 center(1, 1, -1);
+    EXPECT_TRUE(near(glm::normalize(center - c.position), c.forward));
+    // The bounding sphere (radius 3) touches the tighter side of the view.
+    const float half = std::min(kPi / 8, std::atan(std::tan(kPi / 8) * aspect));
+    EXPECT_NEAR(glm::length(center - c.position) * std::sin(half), 3.0f, 1e-4f);
+  }
+  s.bounds_lo = s.bounds_hi = vec3(4, 5, 6);  // a point
+  const wp::Camera c = wp::framing_camera(s, 1.0f);
+  EXPECT_TRUE(std::isfinite(c.position.x + c.position.y + c.position.z));
+  EXPECT_GT(glm::length(c.position - vec3(4, 5, 6)), 0.0f);
+  EXPECT_NEAR(glm::length(c.forward), 1.0f, 1e-6f);
+}
+
+TEST(GltfLoader, ErrorsNameFileAndCause) {
+  Gltf g = one_triangle("");
+  g.top = R"("extensionsUsed":["KHR_draco_mesh_compression"],)"
+          R"("extensionsRequired":["KHR_draco_mesh_compression"])";
+  expect_error(g.write("draco.gltf"), "requires unsupported extension KHR_draco_mesh_compression");
+
+  const std::string missing = (temp_dir() / "missing.gltf").string();
+  expect_error(missing, "no such file");
+  const std::string bad_json = (temp_dir() / "bad.gltf").string();
+  write_bytes(bad_json, R"({"asset":{"version":"2.0"},"nodes":[{"mesh":0})");
+  expect_error(bad_json, "parse error");
+  const std::string empty = (temp_dir() / "empty.gltf").string();
+  write_bytes(empty, "");
+  expect_error(empty, "empty file");
+  expect_error(temp_dir().string(), "is a directory");
+  const std::string not_glb = (temp_dir() / "text.glb").string();
+  write_bytes(not_glb, "{}");
+  expect_error(not_glb, "magic");
+
+  Gltf none = one_triangle("");
+  none.scenes = "";
+  expect_error(none.write("noscene.gltf"), "no scenes");
+}
+
+TEST(GltfLoader, OutOfRangeDataIsAnError) {
+  {  // accessor count beyond its bufferView
+    Gltf g = one_triangle("");
+    g.accessors[0] = R"({"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"})";
+    expect_error(g.write("count.gltf"), "accessor 0 (POSITION)");
+  }
+  {  // index value beyond the vertices
+    Gltf g = one_triangle("");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, g.indices<std::uint16_t>({0, 1, 7})) +
+                "]}"};
+    expect_error(g.write("index.gltf"), "index 7");
+  }
+  {  // bufferView beyond its buffer
+    Gltf g = one_triangle("");
+    g.views[0] = R"({"buffer":0,"byteOffset":4,"byteLength":36})";
+    expect_error(g.write("view.gltf"), "exceeds buffer 0");
+  }
+  {  // missing accessor, matrix-typed accessor, attribute count mismatch
+    Gltf g = one_triangle("");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 9}}) + "]}"};
+    expect_error(g.write("noaccessor.gltf"), "accessor 9 (POSITION) does not exist");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", g.accessor(0, kF32, 1, "MAT3")}}) + "]}"};
+    expect_error(g.write("mat3.gltf"), "unsupported accessor type");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}, {"NORMAL", g.vec3s({{0, 0, 1}})}}) +
+                "]}"};
+    expect_error(g.write("mismatch.gltf"), "differs from POSITION");
+  }
+  {  // node graph: a cycle, a missing child, a missing mesh, a malformed transform
+    Gltf g = one_triangle("\"children\":[1]");
+    g.node("\"children\":[0]");
+    expect_error(g.write("cycle.gltf"), "cycle");
+    g.nodes[1] = "{\"children\":[5]}";
+    expect_error(g.write("child.gltf"), "missing node 5");
+    g.nodes = {"{\"mesh\":3}"};
+    expect_error(g.write("nomesh.gltf"), "mesh 3 does not exist");
+    g.nodes = {"{\"mesh\":0,\"rotation\":[0,0,1]}"};
+    expect_error(g.write("rotation.gltf"), "rotation needs 4 numbers");
+  }
+  {  // a material and a light that do not exist
+    Gltf g = one_triangle("");
+    g.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, -1, 2) + "]}"};
+    expect_error(g.write("nomaterial.gltf"), "material 2 does not exist");
+    Gltf h = one_triangle(R"("extensions":{"KHR_lights_punctual":{"light":0}})");
+    expect_error(h.write("nolight.gltf"), "light 0 does not exist");
+  }
+}
+
+// JSON nested 20,000 deep overflowed the stack in tinygltf (SIGSEGV); it is refused up front, in
+// .gltf text and in a .glb's JSON chunk. Brackets inside strings (with escaped quotes) do not
+// count.
+TEST(GltfLoader, DeeplyNestedJsonIsAnError) {
+  const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+  Gltf g = one_triangle(R"("extras":)" + deep);
+  expect_error(g.write("deep.gltf"), "JSON nested deeper than 64");
+  expect_error(g.write_glb("deep.glb"), "JSON nested deeper than 64");
+  Gltf limit = one_triangle(R"("extras":)" + std::string(60, '[') + std::string(60, ']'));
+  EXPECT_EQ(wp::load_gltf(limit.write("deep60.gltf")).triangle_count(), 1u);
+  Gltf strings = one_triangle(R"("name":"\"[[[[)" + std::string(200, '{') + R"(\\")");
+  EXPECT_EQ(wp::load_gltf(strings.write("brackets_in_name.gltf")).triangle_count(), 1u);
+}
+
+// An empty scene is valid glTF: no nodes, only a camera, or only non-triangle primitives. It loads
+// with zero triangles, a warning, and bounds at the origin (framing_camera still works).
+TEST(GltfLoader, EmptyScenesLoad) {
+  Gltf none = one_triangle("");
+  none.scenes = R"("scene":0,"scenes":[{"nodes":[]}])";
+  Gltf nameless = one_triangle("");
+  nameless.scenes = R"("scenes":[{}])";
+  Gltf camera;
+  camera.cameras = {R"({"type":"perspective","perspective":{"yfov":0.7,"znear":0.1}})"};
+  camera.vec3s({{0, 0, 0}});  // an unused accessor: a buffer cannot be empty
+  camera.node("\"camera\":0", true);
+  Gltf lines = one_triangle("");
+  lines.meshes = {"{\"primitives\":[" + prim({{"POSITION", 0}}, -1, 1) + "]}"};
+  const std::vector<std::pair<const Gltf*, std::size_t>> cases = {
+      {&none, 0}, {&nameless, 0}, {&camera, 1}, {&lines, 0}};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string path = cases[i].first->write("empty" + std::to_string(i) + ".gltf");
+    const wp::Scene s = wp::load_gltf(path);
+    EXPECT_EQ(s.triangle_count(), 0u) << path;
+    EXPECT_EQ(s.cameras.size(), cases[i].second) << path;
+    EXPECT_TRUE(near(s.bounds_lo, {0, 0, 0}) && near(s.bounds_hi, {0, 0, 0})) << path;
+    EXPECT_TRUE(std::any_of(s.warnings.begin(), s.warnings.end(), [](const std::string& w) {
+      return w.find("has no triangles") != std::string::npos;
+    })) << path;
+    const wp::Camera c = wp::framing_camera(s, 1.5f);
+    EXPECT_TRUE(std::isfinite(c.position.x + c.position.y + c.position.z)) << path;
+  }
+}
+
+// Every truncation of a valid .glb, and random byte corruptions of it, either load or throw
+// wp::Error (run under ASan or valgrind to check for out-of-range reads).
+TEST(GltfLoader, TruncatedAndCorruptedGlbNeverCrash) {
+  const std::string bytes = hierarchy().glb();
+  const std::string path = (temp_dir() / "mutant.glb").string();
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    write_bytes(path, bytes.substr(0, n));
+    EXPECT_THROW(wp::load_gltf(path), wp::Error) << "truncated to " << n;
+  }
+  std::mt19937 rng(7);
+  int loaded = 0;
+  for (int i = 0; i < 1500; ++i) {
+    std::string m = bytes;
+    for (int k = 0; k < 1 + i % 3; ++k) m[rng() % m.size()] = "\x00\xff\x7f:,[]}\"-9e0"[rng() % 13];
+    write_bytes(path, m);
+    try {
+      const wp::Scene s = wp::load_gltf(path);
+      if (s.triangle_count() == 0) continue;  // e.g. a corrupted "mesh" key: a valid empty scene
+      check_invariants(s);
+      ++loaded;
+    } catch (const wp::Error&) {
+    }
+  }
+  EXPECT_GT(loaded, 0);  // some mutations are harmless (e.g. inside a name)
+}
+
+}  // namespace

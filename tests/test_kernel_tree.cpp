@@ -1,0 +1,106 @@
+// The kernels/ tree as a newcomer meets it: every stage's entry point (kernels/<stage>.cl) builds
+// on its own, with nothing but what it includes, and defines exactly its stage's kernel; and no
+// kernel file reaches a path-state lane except through the accessors path_state.h generates from
+// shared/path_state.def.
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "host/device/cl_runtime.h"
+#include "host/device/kernel_sources.h"
+#include "host/render/pipeline.h"
+
+namespace {
+
+class KernelSourcesOnDevice : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
+  static void TearDownTestSuite() {
+    delete runtime_;
+    runtime_ = nullptr;
+  }
+  static wp::ClRuntime* runtime_;
+};
+wp::ClRuntime* KernelSourcesOnDevice::runtime_ = nullptr;
+
+// Each stage's .cl alone, every feature on (features.h's defaults) and AOVs, so that every
+// #if branch a stage has is compiled: it builds, and its program holds one kernel, the stage's.
+TEST_F(KernelSourcesOnDevice, EachStageBuildsAlone) {
+  for (const char* name : wp::kStageNames) {
+    SCOPED_TRACE(name);
+    const std::string source = wp::KernelSources().expand({std::string(name) + ".cl"});
+    cl::Program program;
+    ASSERT_NO_THROW(program = runtime_->build(source, "-cl-std=CL1.2 -D WP_AOV=1"));
+    EXPECT_EQ(program.getInfo<CL_PROGRAM_KERNEL_NAMES>(), name);
+  }
+}
+
+// The path-state fields, in the order path_state.def declares them.
+std::vector<std::string> path_fields() {
+  std::vector<std::string> fields;
+  for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
+    if (std::string(f.name) != "shared/path_state.def") continue;
+    const std::regex field(R"(^WP_PATH_(?:AOV_)?FIELD\(\w+,\s*(\w+),)");
+    std::istringstream lines(f.text);
+    for (std::string line; std::getline(lines, line);) {
+      std::smatch m;
+      if (std::regex_search(line, m, field)) fields.push_back(m[1]);
+    }
+  }
+  return fields;
+}
+
+// A field indexed by slot (`paths.info[slot]`, `p.hit [i]`): the raw access the accessors replace.
+std::regex raw_access(const std::vector<std::string>& fields) {
+  std::string alternatives;
+  for (const auto& f : fields) alternatives += (alternatives.empty() ? "" : "|") + f;
+  return std::regex(R"(\.\s*()" + alternatives + R"()\s*\[)");
+}
+
+TEST(KernelSources, PathStateIsReachedOnlyThroughItsAccessors) {
+  const std::vector<std::string> fields = path_fields();
+  ASSERT_GE(fields.size(), 14u) << "path_state.def not found or not parsed";
+  const std::regex raw = raw_access(fields);
+  // The pattern catches what it is meant to (else the test below could pass by matching nothing).
+  EXPECT_TRUE(std::regex_search(std::string("paths.info[slot].w = 0u;"), raw));
+  EXPECT_TRUE(std::regex_search(std::string("p . throughput [i].xyz"), raw));
+  EXPECT_FALSE(
+      std::regex_search(std::string("path_info(paths, slot); wp_prefetch(paths.hit + s)"), raw));
+  int files = 0;
+  for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
+    const std::string name = f.name;
+    if (name == "path_state.h") continue;  // the accessors themselves
+    ++files;
+    std::istringstream lines(f.text);
+    int number = 0;
+    for (std::string line; std::getline(lines, line);) {
+      ++number;
+      EXPECT_FALSE(std::regex_search(line, raw)) << name << ":" << number << ": " << line;
+    }
+  }
+  EXPECT_GT(files, 20);
+}
+
+// Every stage has its entry point, and every stage but the fused one its logic header; the fused
+// shade includes the four headers of the stages it fuses.
+TEST(KernelSources, EveryStageHasItsFiles) {
+  std::set<std::string> names;
+  for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) names.insert(f.name);
+  for (const char* stage : wp::kStageNames) {
+    const std::string s = stage;
+    EXPECT_TRUE(names.count(s + ".cl")) << s;
+    if (s != "shade") {
+      EXPECT_TRUE(names.count("integrator/" + s + ".h")) << s;
+    }
+  }
+  const std::string fused = wp::KernelSources().expand({"shade.cl"});
+  for (const char* header : {"shade_surface", "sample_lights", "sample_bsdf", "roulette_compact"})
+    EXPECT_NE(fused.find(std::string("#line 1 \"integrator/") + header + ".h\""), std::string::npos)
+        << header;
+}
+
+}  // namespace
