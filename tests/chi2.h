@@ -45,7 +45,9 @@ inline double gamma_q(double a, double x) {
 }
 
 // P(X >= x) for X chi-square distributed with `dof` degrees of freedom.
-inline double chi2_sf(double x, int dof) { return gamma_q(0.5 * dof, 0.5 * x); }
+inline double chi2_sf(double x, int dof) {
+  return gamma_q(0.5 * dof, 0.5 * x);
+}
 
 struct Chi2Result {
   double statistic = 0.0;
@@ -80,8 +82,8 @@ inline Chi2Result chi2_test(const std::vector<double>& observed,
   r.dof = std::max(1, bins - 1);
   r.p_value = r.observed_outside > 0.0 ? 0.0 : chi2_sf(r.statistic, r.dof);
   std::ostringstream s;
-  s << "chi2 " << r.statistic << " dof " << r.dof << " p " << r.p_value << " (samples where the pdf is 0: "
-    << r.observed_outside << ")";
+  s << "chi2 " << r.statistic << " dof " << r.dof << " p " << r.p_value
+    << " (samples where the pdf is 0: " << r.observed_outside << ")";
   r.detail = s.str();
   return r;
 }

@@ -141,7 +141,11 @@ Quad diffuse_albedo(const Material& m, V3 wo, double eta, int n) {
     double sn, cos_i;
   };
   return converge(
-      n, [](double s2) { return Row{std::sqrt(s2), std::sqrt(1.0 - s2)}; }, azimuth,
+      n,
+      [](double s2) {
+        return Row{std::sqrt(s2), std::sqrt(1.0 - s2)};
+      },
+      azimuth,
       [&](const Row& r, const Azimuth& a) {
         const V3 wi = {r.sn * a.c, r.sn * a.s, r.cos_i};
         const V3 sum = wo + wi;

@@ -1,8 +1,9 @@
-// kernel tier: texture sampling (kernels/textures.h), alpha (kernels/alpha.h) and material resolution
-// (kernels/material.h) on the OpenCL device, against host references written here from the glTF
-// 2.0 specification (its samplers follow OpenGL: texel centres at (i + 0.5) / size, wrap modes on
-// texel indices, NEAREST or bilinear LINEAR magnification) and the sRGB standard, over scenes
-// packed by host/device/device_scene.cpp exactly as renders are. The references compute in double.
+// kernel tier: texture sampling (kernels/textures.h), alpha (kernels/alpha.h) and material
+// resolution (kernels/material.h) on the OpenCL device, against host references written here from
+// the glTF 2.0 specification (its samplers follow OpenGL: texel centres at (i + 0.5) / size, wrap
+// modes on texel indices, NEAREST or bilinear LINEAR magnification) and the sRGB standard, over
+// scenes packed by host/device/device_scene.cpp exactly as renders are. The references compute in
+// double.
 //
 // Tolerances are float rounding bounds, derived where they are used (texture_bound()). Bilinear
 // filtering is 1-Lipschitz in the texel-space position per axis (texel values lie in [0, 1]), so
