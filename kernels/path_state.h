@@ -4,6 +4,8 @@
  *
  *   path_bounce(paths, slot)             the lane's value
  *   path_set_bounce(paths, slot, value)  stores it, leaving the field's other lanes as they are
+ *   path_store_ray_o(paths, slot, origin, tmin)
+ *                                        stores a whole field from its lanes, in order
  *
  * These are the only code that indexes the path state (tests/test_kernel_tree.cpp checks that no
  * other kernel file does); prefetch_path (stage.h) takes a field's address, not a lane. */
@@ -26,22 +28,43 @@ static inline Paths paths_bind(__global uchar* base, PathLayout layout) {
   return p;
 }
 
+/* A setter stores its lanes alone, through a pointer to the field's scalars: no load of the lanes
+ * it keeps (an assignment to a swizzle would read the whole vector first), and the stores of a
+ * field's lanes, one after another, can be merged into one. OpenCL C assumes no strict aliasing
+ * unless built with -cl-strict-aliasing. */
+#define WP_PATH_STORE_x(type, p, v) (((__global type*)(p))[0] = (v))
+#define WP_PATH_STORE_y(type, p, v) (((__global type*)(p))[1] = (v))
+#define WP_PATH_STORE_z(type, p, v) (((__global type*)(p))[2] = (v))
+#define WP_PATH_STORE_w(type, p, v) (((__global type*)(p))[3] = (v))
+#define WP_PATH_STORE_xyz(type, p, v) vstore3((v), 0, (__global float*)(p))
+
 #define WP_PATH_FIELD(type, name, description)
 #define WP_PATH_LANE(field, lanes, type, name, description)                \
   static inline type path_##name(Paths paths, uint slot) {                 \
     return paths.field[slot].lanes;                                        \
   }                                                                        \
   static inline void path_set_##name(Paths paths, uint slot, type value) { \
-    paths.field[slot].lanes = value;                                       \
+    WP_PATH_STORE_##lanes(type, paths.field + slot, value);                \
   }
 #define WP_PATH_LANE_BITS(field, lane, type, stored, name, description)    \
   static inline type path_##name(Paths paths, uint slot) {                 \
     return as_##type(paths.field[slot].lane);                              \
   }                                                                        \
   static inline void path_set_##name(Paths paths, uint slot, type value) { \
-    paths.field[slot].lane = as_##stored(value);                           \
+    WP_PATH_STORE_##lane(stored, paths.field + slot, as_##stored(value));  \
+  }
+#define WP_PATH_STORE3(field, xyz, w, w_type, w_to_float)                               \
+  static inline void path_store_##field(Paths paths, uint slot, float3 xyz, w_type w) { \
+    paths.field[slot] = (float4)(xyz, w_to_float(w));                                   \
+  }
+#define WP_PATH_STORE4(field, vector, scalar, x, y, z, w, w_type, w_convert)                  \
+  static inline void path_store_##field(Paths paths, uint slot, scalar x, scalar y, scalar z, \
+                                        w_type w) {                                           \
+    paths.field[slot] = (vector)(x, y, z, w_convert(w));                                      \
   }
 #include "shared/path_state.def"
+#undef WP_PATH_STORE4
+#undef WP_PATH_STORE3
 #undef WP_PATH_LANE_BITS
 #undef WP_PATH_LANE
 #undef WP_PATH_FIELD

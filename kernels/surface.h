@@ -7,17 +7,11 @@
 #include "path_state.h"
 
 static inline void surface_store(Paths paths, uint slot, const Surface* s) {
-  path_set_surf_p(paths, slot, s->p);
-  path_set_surf_p_scale(paths, slot, s->p_scale);
-  path_set_surf_ng(paths, slot, s->ng);
-  path_set_surf_specular(paths, slot, s->specular);
+  path_store_surf_p(paths, slot, s->p, s->p_scale);
+  path_store_surf_ng(paths, slot, s->ng, s->specular);
   path_set_surf_ns(paths, slot, s->ns);
-  path_set_surf_color(paths, slot, s->color);
-  path_set_surf_metallic(paths, slot, s->metallic);
-  path_set_surf_roughness(paths, slot, s->roughness);
-  path_set_surf_ior(paths, slot, s->ior);
-  path_set_surf_transmission(paths, slot, s->transmission);
-  path_set_surf_flags(paths, slot, s->flags);
+  path_store_surf_color(paths, slot, s->color, s->metallic);
+  path_store_surf_params(paths, slot, s->roughness, s->ior, s->transmission, s->flags);
 }
 
 static inline Surface surface_load(Paths paths, uint slot) {

@@ -18,23 +18,15 @@ WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, ui
   float3 o, d;
   float tmin;
   camera_ray(camera, ndc, &o, &d, &tmin);
-  path_set_ray_origin(paths, slot, o);
-  path_set_ray_tmin(paths, slot, tmin);
-  path_set_ray_dir(paths, slot, d);
-  path_set_ray_tmax(paths, slot, INFINITY);
-  path_set_throughput(paths, slot, (float3)(1.0f));
-  path_set_bsdf_pdf(paths, slot, 0.0f); /* a camera ray: no BSDF sample to weigh against */
-  path_set_radiance(paths, slot, (float3)(0.0f));
-  path_set_eta_scale(paths, slot, 1.0f);
-  path_set_pixel(paths, slot, pixel);
-  path_set_bounce(paths, slot, 0u);
-  path_set_flags(paths, slot, 0u);
-  path_set_pane_distance(paths, slot, 0.0f);
+  path_store_ray_o(paths, slot, o, tmin);
+  path_store_ray_d(paths, slot, d, INFINITY);
+  /* A camera ray: no BSDF sample to weigh against (pdf 0). */
+  path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
+  path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
+  path_store_info(paths, slot, pixel, 0u, 0u, 0.0f);
 #if WP_AOV
-  path_set_aov_albedo(paths, slot, (float3)(0.0f));
-  path_set_aov_depth(paths, slot, 0.0f);
-  path_set_aov_normal(paths, slot, (float3)(0.0f));
-  path_set_aov_recorded(paths, slot, 0.0f);
+  path_store_aov_albedo(paths, slot, (float3)(0.0f), 0.0f);
+  path_store_aov_normal(paths, slot, (float3)(0.0f), 0.0f);
 #endif
 }
 

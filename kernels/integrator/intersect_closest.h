@@ -18,17 +18,10 @@ WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch laun
   const TraceRay ray = trace_ray(path_ray_origin(paths, slot), path_ray_dir(paths, slot),
                                  path_ray_tmin(paths, slot), key);
   TraceHit hit;
-  if (bvh_trace(scene, &ray, path_ray_tmax(paths, slot), &hit, false)) {
-    path_set_hit_t(paths, slot, hit.t);
-    path_set_hit_u(paths, slot, hit.u);
-    path_set_hit_v(paths, slot, hit.v);
-    path_set_hit_triangle(paths, slot, hit.tri);
-  } else {
-    path_set_hit_t(paths, slot, INFINITY);
-    path_set_hit_u(paths, slot, 0.0f);
-    path_set_hit_v(paths, slot, 0.0f);
-    path_set_hit_triangle(paths, slot, 0u);
-  }
+  if (bvh_trace(scene, &ray, path_ray_tmax(paths, slot), &hit, false))
+    path_store_hit(paths, slot, hit.t, hit.u, hit.v, hit.tri);
+  else
+    path_store_hit(paths, slot, INFINITY, 0.0f, 0.0f, 0u);
 }
 
 #endif /* WP_INTEGRATOR_INTERSECT_CLOSEST_H */

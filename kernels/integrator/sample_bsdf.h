@@ -20,31 +20,29 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
   const bool finite = all(isfinite(next)) && isfinite(bs.pdf);
   if (bs.valid && !finite) count_nonfinite(queues);
   if (!bs.valid || !finite) {
-    path_set_throughput(paths, slot, (float3)(0.0f));
-    path_set_bsdf_pdf(paths, slot, 0.0f);
+    path_store_throughput(paths, slot, (float3)(0.0f), 0.0f);
     return;
   }
   path_set_eta_scale(paths, slot, path_eta_scale(paths, slot) * bs.eta_scale);
-  path_set_throughput(paths, slot, next);
+  float pdf = bs.pdf;
 #if WP_FEATURE_TRANSMISSION
   /* Straight through a smooth thin-walled transmitter, which shadow rays pass too (trace_shadow):
    * the path goes on along the direction the previous vertex sampled, so it keeps that sample's
    * pdf and flags for MIS at the next hit, and counts the distance to that vertex for the light's
    * pdf there. */
   if (bs.delta && !bsdf_volume(s) && dot(bs.wi, s->ng) < 0.0f) {
+    pdf = path_bsdf_pdf(paths, slot);
     path_set_pane_distance(paths, slot, path_pane_distance(paths, slot) + path_hit_t(paths, slot));
   } else
 #endif
   {
-    path_set_bsdf_pdf(paths, slot, bs.pdf);
     path_set_flags(paths, slot, bs.delta ? WP_PATH_DELTA : 0u);
     path_set_pane_distance(paths, slot, 0.0f);
   }
+  path_store_throughput(paths, slot, next, pdf);
   /* Leave on the side the new direction goes to (below for transmission). */
-  path_set_ray_origin(paths, slot, surface_spawn(s, ray_d, path_hit_t(paths, slot), bs.wi));
-  path_set_ray_tmin(paths, slot, 0.0f);
-  path_set_ray_dir(paths, slot, bs.wi);
-  path_set_ray_tmax(paths, slot, INFINITY);
+  path_store_ray_o(paths, slot, surface_spawn(s, ray_d, path_hit_t(paths, slot), bs.wi), 0.0f);
+  path_store_ray_d(paths, slot, bs.wi, INFINITY);
 }
 
 #endif /* WP_INTEGRATOR_SAMPLE_BSDF_H */

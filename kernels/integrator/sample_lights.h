@@ -39,10 +39,8 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
     tmax = length(to);
     dir = to / tmax;
   }
-  path_set_shadow_origin(paths, slot, o);
-  path_set_shadow_tmax(paths, slot, tmax);
-  path_set_shadow_dir(paths, slot, dir);
-  path_set_shadow_bounce(paths, slot, path_bounce(paths, slot));
+  path_store_shadow_o(paths, slot, o, tmax);
+  path_store_shadow_d(paths, slot, dir, path_bounce(paths, slot));
   path_set_shadow_radiance(paths, slot, c);
   return true;
 }

@@ -98,12 +98,20 @@ TEST_F(Stages, GenerateCameraRaysStartEveryPathInItsPixel) {
 
 // intersect_closest: the hit of every queued ray equals the CPU reference traversal of the same
 // BVH (bvh::intersect_closest, bvh/traverse_common.h: the same arithmetic, no fused
-// multiply-adds, so bit for bit), t, barycentrics and triangle; a miss is t = INFINITY, u = v = 0,
+// multiply-adds, so bit for bit on a CPU device, whose single-precision division is IEEE's; OpenCL
+// 1.2 lets other devices divide within 2.5 ulp, which the watertight test's shear and inverse
+// determinant carry into t, u and v: there the same triangle, with u, v within 4e-6 and t within
+// 4e-6 of the larger of t and the origin's largest coordinate (the test works in coordinates
+// relative to the origin, so a rounding there moves t by as much however near the hit is): some
+// 20 times the largest differences an NVIDIA H200 showed, 2.1e-7 in u, 1.8e-8 in t at t 3e-4),
+// t, barycentrics and triangle; a miss is t = INFINITY, u = v = 0,
 // triangle 0. Camera rays (bounce 0) and BSDF-sampled rays leaving surfaces (bounces 1 and 2),
 // on both BVH layouts; and the camera rays again with other tmin and tmax (a window of the ray
 // from 0.9 or 1.0, the eye being 0.8 before the box, to 1.2 or infinity), which the renderer's
 // rays leave at znear and infinity. Nothing but the queued slots' hit records changes.
 TEST_F(Stages, IntersectClosestMatchesTheCpuTraversal) {
+  const bool exact_division =
+      runtime_->device().device.getInfo<CL_DEVICE_TYPE>() == CL_DEVICE_TYPE_CPU;
   for (const Traversal& tr : traversals()) {
     for (int k = 0; k <= kBounces; ++k) {
       const bool window = k == kBounces;
@@ -139,9 +147,13 @@ TEST_F(Stages, IntersectClosestMatchesTheCpuTraversal) {
         const float4 h = after.f4(layout().hit, slot);
         hits += ref.hit;
         if (ref.hit) {
-          WP_CHECK(f,
-                   bits(h.x) == bits(ref.t) && bits(h.y) == bits(ref.u) &&
-                       bits(h.z) == bits(ref.v) && bits(h.w) == ref.triangle,
+          const bool same =
+              exact_division
+                  ? bits(h.x) == bits(ref.t) && bits(h.y) == bits(ref.u) && bits(h.z) == bits(ref.v)
+                  : std::fabs(h.x - ref.t) <= 4e-6f * std::max({ref.t, std::fabs(o.x),
+                                                                std::fabs(o.y), std::fabs(o.z)}) &&
+                        std::fabs(h.y - ref.u) <= 4e-6f && std::fabs(h.z - ref.v) <= 4e-6f;
+          WP_CHECK(f, same && bits(h.w) == ref.triangle,
                    "slot " << slot << ": t " << h.x << " u " << h.y << " v " << h.z << " triangle "
                            << bits(h.w) << ", the reference " << ref.t << " " << ref.u << " "
                            << ref.v << " " << ref.triangle);
