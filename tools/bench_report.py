@@ -30,10 +30,9 @@ import re
 import subprocess
 import sys
 
-STAGES = [
-    "generate_camera_rays", "intersect_closest", "shade_surface", "sample_lights",
-    "trace_shadow", "sample_bsdf", "roulette_compact", "shade", "accumulate",
-]
+from stage_names import stage_names
+
+STAGES = stage_names()  # host/render/pipeline.h's kStageNames
 END_TO_END = ["render", "bvh_build", "program_build"]
 # The block of docs/performance.md that --markdown rewrites: from the line starting with BEGIN to
 # the line END.

@@ -43,11 +43,12 @@ import subprocess
 import sys
 import tempfile
 
+from stage_names import stage_names
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNELS = os.path.join(ROOT, "kernels")
-# host/render/stages.h kStageNames: the order program_source() concatenates them in.
-STAGES = ["generate_camera_rays", "intersect_closest", "shade_surface", "sample_lights",
-          "trace_shadow", "sample_bsdf", "roulette_compact", "shade", "accumulate"]
+# host/render/pipeline.h's kStageNames: the order program_source() concatenates them in.
+STAGES = stage_names()
 TRAVERSAL = ("intersect_closest", "trace_shadow")
 SKIP = 77
 
