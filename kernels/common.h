@@ -15,10 +15,10 @@
 #define WP_INV_PI 0.31830988618379067154f
 #define WP_INF INFINITY
 
-/* For the per-path bodies of the stages (shade_surface.cl, sample_lights.cl, sample_bsdf.cl,
- * roulette_compact.cl), each called from its own kernel and from the fused shade.cl: with two
- * callers clang keeps them out of line, and the surface they take by pointer then lives in a
- * stack frame (local memory on GPUs: ptxas showed 416-864 B per thread; tools/gpu_compile.py). */
+/* For the per-path bodies of the stages (integrator/<stage>.h), several called from their own
+ * kernel and from the fused shade.cl: with two callers clang keeps them out of line, and the
+ * surface they take by pointer then lives in a stack frame (local memory on GPUs, as ptxas shows
+ * through tools/gpu_compile.py). */
 #define WP_STAGE_FN static inline __attribute__((always_inline))
 
 static inline float max3(float3 v) {
