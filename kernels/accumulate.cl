@@ -9,7 +9,5 @@
 __kernel void accumulate(WP_STAGE_PARAMS, __global ulong* film) {
   WP_STAGE_BIND;
   const uint first = get_global_id(0);
-  /* A wave without paths (the host's priming launch) has no pixel to read either. */
-  if (first < launch.wave_pixels && first < launch.path_count)
-    accumulate_pixel(paths, queues, launch, film, first);
+  if (first < launch.wave_pixels) accumulate_pixel(paths, queues, launch, film, first);
 }

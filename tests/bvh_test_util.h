@@ -19,22 +19,14 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
+#include "tests/float_bits.h"
 
 namespace wp::bvh::test {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-inline std::uint32_t bits(float f) {
-  std::uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
-}
-
-inline float as_float(std::uint32_t u) {
-  float f;
-  std::memcpy(&f, &u, sizeof f);
-  return f;
-}
+using wp::test::as_float;
+using wp::test::bits;
 
 // ---------------------------------------------------------------------------------------------
 // Meshes

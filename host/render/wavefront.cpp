@@ -197,8 +197,9 @@ cl::Kernel& Wavefront::kernel(Stage stage) {
 // the build (where kernel_build_seconds reports it) instead of the first sample pass; the other
 // pipeline's stages would add to the cold build for nothing.
 void Wavefront::prime_kernels() {
-  dev::Launch p = launch_params(0, 0, 0);  // no paths: every work-item returns at once
-  p.wave_pixels = 1;  // never divided by here (no work-item gets past path_count 0), but not by 0
+  // An empty wave: no paths, no pixels, so every work-item returns at once (none gets to a
+  // division by wave_pixels, nor reads path state).
+  dev::Launch p = launch_params(0, 0, 0);
   p.queue_in = WP_QUEUE_RAY_A;
   p.queue_out = WP_QUEUE_RAY_B;
   try {

@@ -46,6 +46,7 @@
 #include "host/render/render.h"
 #include "host/render/wavefront.h"
 #include "host/scene/gltf_loader.h"
+#include "tests/float_bits.h"
 
 namespace wp::test::stages {
 
@@ -65,16 +66,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr std::uint32_t kSurfFront = 4u;  // WP_SURF_FRONT of kernels/bsdf.h (OpenCL C only)
 
-inline std::uint32_t bits(float f) {
-  std::uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
-}
-inline float as_float(std::uint32_t u) {
-  float f;
-  std::memcpy(&f, &u, sizeof f);
-  return f;
-}
+using wp::test::as_float;
+using wp::test::bits;
 inline vec3 xyz(const float4& v) {
   return {v.x, v.y, v.z};
 }
@@ -325,6 +318,18 @@ class Stages : public ::testing::Test {
     dvec3 cross;       // (p1 - p0) x (p2 - p0): the front side's normal, twice the area long
     const wp::Material* material;
   };
+  // How far surface_spawn may move a ray's origin from the surface point of `slot`: the offset
+  // distance along ng and at most as much back along the incoming ray, so at most 2 offsets, plus
+  // the rounding of the two float additions (an ulp of the point's magnitude each; 2^-21 of
+  // p_scale is 4 of them).
+  struct SpawnBound {
+    double offset, rounding;
+  };
+  static SpawnBound spawn_bound(const PathView& v, std::uint32_t slot) {
+    const double p_scale = v.f4(layout().surf_p, slot).w;
+    return {std::ldexp(p_scale, -16), std::ldexp(p_scale, -21)};
+  }
+
   static Triangle triangle(std::uint32_t tri) {
     Triangle t;
     for (int k = 0; k < 3; ++k) {

@@ -220,11 +220,7 @@ TEST_F(Stages, SampleLightsMakesShadowRaysToLightPoints) {
       double min_cos = 0.0;
       const dvec3 p = before.d3(layout().surf_p, slot), ng = before.d3(layout().surf_ng, slot),
                   ns = before.d3(layout().surf_ns, slot);
-      // surface_spawn moves the point by the offset distance along ng and at most as much back
-      // along the incoming ray: at most 2 offsets, plus the rounding of the two float additions
-      // (an ulp of the point's magnitude each; 2^-21 of p_scale is 4 of them).
-      const double p_scale = before.f4(layout().surf_p, slot).w;
-      const double off = std::ldexp(p_scale, -16), rounding = std::ldexp(p_scale, -21);
+      const auto [off, rounding] = spawn_bound(before, slot);
       const dvec3 color = before.d3(layout().surf_color, slot);
       const dvec3 beta = before.d3(layout().throughput, slot);
       const float4 so = after.f4(layout().shadow_o, slot), sd = after.f4(layout().shadow_d, slot);
@@ -365,11 +361,7 @@ TEST_F(Stages, SampleBsdfSamplesLambertsCosineLobe) {
     for (const std::uint32_t slot : surfaces) {
       const dvec3 p = before.d3(layout().surf_p, slot), ng = before.d3(layout().surf_ng, slot),
                   ns = before.d3(layout().surf_ns, slot);
-      // surface_spawn moves the point by the offset distance along ng and at most as much back
-      // along the incoming ray: at most 2 offsets, plus the rounding of the two float additions
-      // (an ulp of the point's magnitude each; 2^-21 of p_scale is 4 of them).
-      const double p_scale = before.f4(layout().surf_p, slot).w;
-      const double off = std::ldexp(p_scale, -16), rounding = std::ldexp(p_scale, -21);
+      const auto [off, rounding] = spawn_bound(before, slot);
       const vec3 color = before.v3(layout().surf_color, slot);
       const float4 beta0 = before.f4(layout().throughput, slot);
       const float4 beta = after.f4(layout().throughput, slot);
