@@ -42,6 +42,30 @@
 #define WP_FEATURE_VOLUME 1 /* KHR_materials_volume: refraction and absorption */
 #endif
 
+/* The material extensions beyond metallic-roughness (kernels/bsdf.h), each compiled in only when
+ * a material of the scene uses it (host/device/scene_features.cpp). */
+#ifndef WP_FEATURE_SPECULAR
+#define WP_FEATURE_SPECULAR 1 /* KHR_materials_specular colour or textures */
+#endif
+#ifndef WP_FEATURE_CLEARCOAT
+#define WP_FEATURE_CLEARCOAT 1 /* KHR_materials_clearcoat */
+#endif
+#ifndef WP_FEATURE_SHEEN
+#define WP_FEATURE_SHEEN 1 /* KHR_materials_sheen */
+#endif
+#ifndef WP_FEATURE_ANISOTROPY
+#define WP_FEATURE_ANISOTROPY 1 /* KHR_materials_anisotropy */
+#endif
+#ifndef WP_FEATURE_IRIDESCENCE
+#define WP_FEATURE_IRIDESCENCE 1 /* KHR_materials_iridescence */
+#endif
+#ifndef WP_FEATURE_DIFFUSE_TRANSMISSION
+#define WP_FEATURE_DIFFUSE_TRANSMISSION 1 /* KHR_materials_diffuse_transmission */
+#endif
+#ifndef WP_FEATURE_DISPERSION
+#define WP_FEATURE_DISPERSION 1 /* KHR_materials_dispersion (with KHR_materials_volume) */
+#endif
+
 /* Sample pattern (rng.h): Owen-scrambled Sobol' (the light and BSDF pairs of two bounces chained
  * to one order, or padded: every group in an order of its own) or independent hashes. */
 #define WP_SAMPLER_INDEPENDENT 0

@@ -37,25 +37,34 @@ static inline float3 material_emission(const SceneView* scene, uint4 tv, float u
   return e;
 }
 
-#if WP_FEATURE_NORMAL_MAPS
-/* The normal texture's normal at the point, in the front side's frame: the tangent-space normal
- * (texel * 2 - 1, x and y times the normal scale) in the basis tangent t (the interpolated vertex
- * tangent made orthogonal to n), bitangent cross(n, t) * w (glTF's convention; w the handedness)
- * and n, the interpolated vertex normal on the front side. */
-static inline float3 normal_mapped(const SceneView* scene, __global const Material* m, uint4 tv,
-                                   float u, float v, float4 uv, float3 n) {
+#if WP_FEATURE_NORMAL_MAPS || WP_FEATURE_ANISOTROPY || WP_FEATURE_CLEARCOAT
+/* The tangent frame at the point: tangent t (the interpolated vertex tangent made orthogonal to
+ * n, the interpolated vertex normal on the front side) and bitangent cross(n, t) * w (glTF's
+ * convention; w the handedness). Without a usable tangent any frame around n: a map's orientation
+ * is lost there, not its tilt. */
+static inline void tangent_frame(const SceneView* scene, uint4 tv, float u, float v, float3 n,
+                                 float3* t, float3* b) {
   const float4 t4 = interpolate4(scene->tangents, tv, u, v);
-  float3 t = t4.xyz - n * dot(n, t4.xyz);
-  float3 b;
-  const float len = length(t);
+  *t = t4.xyz - n * dot(n, t4.xyz);
+  const float len = length(*t);
   if (len > 1e-6f) {
-    t /= len;
-    b = cross(n, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
+    *t /= len;
+    *b = cross(n, *t) * (t4.w < 0.0f ? -1.0f : 1.0f);
   } else {
-    make_basis(n, &t, &b); /* no usable tangent: the map's orientation is lost, not its tilt */
+    make_basis(n, t, b);
   }
-  float3 c = texture_sample(scene, m->textures0.z, uv).xyz * 2.0f - 1.0f;
-  c.xy *= m->extra.x;
+}
+#endif
+
+#if WP_FEATURE_NORMAL_MAPS || WP_FEATURE_CLEARCOAT
+/* The normal of normal texture `tex` at the point, in the front side's frame: the tangent-space
+ * normal (texel * 2 - 1, x and y times `scale`) in the tangent frame around n. */
+static inline float3 normal_mapped(const SceneView* scene, int tex, float scale, uint4 tv, float u,
+                                   float v, float4 uv, float3 n) {
+  float3 t, b;
+  tangent_frame(scene, tv, u, v, n, &t, &b);
+  float3 c = texture_sample(scene, tex, uv).xyz * 2.0f - 1.0f;
+  c.xy *= scale;
   const float3 p = c.x * t + c.y * b + c.z * n;
   const float lp = length(p);
   return lp > 0.0f ? p / lp : n;
@@ -92,8 +101,7 @@ static inline void resolve_material(const SceneView* scene, __global const Mater
   s->roughness = q.y;
   s->ior = q.z;
   s->transmission = q.w;
-  s->specular =
-      m->extra.z; /* KHR_materials_specular factor (host/device/device_scene.cpp packs it) */
+  s->specular = m->specular.w; /* KHR_materials_specular factor */
 #if WP_FEATURE_TEXTURES
   const int4 tex = m->textures0;
   if (tex.x >= 0) color *= texture_sample(scene, tex.x, uv).xyz;
@@ -108,6 +116,97 @@ static inline void resolve_material(const SceneView* scene, __global const Mater
 #endif
   s->color = color;
 }
+
+/* Any material extension beyond metallic-roughness in the program. */
+#define WP_BSDF_EXTENSIONS                                                                     \
+  (WP_FEATURE_SPECULAR || WP_FEATURE_CLEARCOAT || WP_FEATURE_SHEEN || WP_FEATURE_ANISOTROPY || \
+   WP_FEATURE_IRIDESCENCE || WP_FEATURE_DIFFUSE_TRANSMISSION || WP_FEATURE_DISPERSION)
+
+#if WP_BSDF_EXTENSIONS
+/* A texture's texel at the point, or 1 without the texture (or without textures in the
+ * program): what multiplies a factor, as glTF specifies. */
+static inline float4 texel_or_one(const SceneView* scene, int tex, float4 uv) {
+#if WP_FEATURE_TEXTURES
+  if (tex >= 0) return texture_sample(scene, tex, uv);
+#else
+  (void)scene, (void)tex, (void)uv;
+#endif
+  return (float4)(1.0f);
+}
+
+/* The material extensions at the point, each only in programs with its feature: factors x
+ * textures, the coat normal (the interpolated normal n_front, or the coat's normal texture, turned
+ * to the side of wo like ns) and the anisotropy direction (the rotation and the texture's
+ * direction in the tangent frame, made perpendicular to ns; a strength of 0 where no direction
+ * is left). */
+static inline void resolve_extensions(const SceneView* scene, __global const Material* m, uint4 tv,
+                                      float u, float v, float4 uv, float3 n_front, float3 wo,
+                                      Surface* s) {
+  (void)scene, (void)tv, (void)u, (void)v, (void)uv, (void)n_front, (void)wo;
+#if WP_FEATURE_SPECULAR
+  s->specular *= texel_or_one(scene, m->textures1.y, uv).w;
+  s->specular_color = m->specular.xyz * texel_or_one(scene, m->textures1.z, uv).xyz;
+#endif
+#if WP_FEATURE_CLEARCOAT
+  s->clearcoat = m->clearcoat.x * texel_or_one(scene, m->textures1.w, uv).x;
+  s->clearcoat_roughness = m->clearcoat.y * texel_or_one(scene, m->textures2.x, uv).y;
+  float3 nc = n_front;
+#if WP_FEATURE_TEXTURES
+  const bool coat_mapped = m->textures2.y >= 0;
+  if (coat_mapped) nc = normal_mapped(scene, m->textures2.y, m->clearcoat.z, tv, u, v, uv, nc);
+#endif
+  if (dot(nc, s->ng) < 0.0f) nc = -nc;
+#if WP_FEATURE_TEXTURES
+  if (coat_mapped) nc = keep_reflection_above(nc, s->ng, wo);
+#endif
+  s->nc = dot(nc, wo) > 1e-4f ? nc : s->ng;
+#endif
+#if WP_FEATURE_SHEEN
+  const float4 sheen_c = texel_or_one(scene, m->textures2.z, uv);
+  s->sheen_color = m->sheen.xyz * sheen_c.xyz;
+  s->sheen_roughness = m->sheen.w * texel_or_one(scene, m->textures2.w, uv).w;
+#endif
+#if WP_FEATURE_ANISOTROPY
+  float strength = m->anisotropy.x;
+  float2 dir = m->anisotropy.yz; /* (cos, sin) of the rotation */
+#if WP_FEATURE_TEXTURES
+  if (m->textures3.x >= 0) {
+    const float4 a = texture_sample(scene, m->textures3.x, uv);
+    const float2 d = a.xy * 2.0f - 1.0f; /* rotated by the rotation */
+    dir = (float2)(dir.x * d.x - dir.y * d.y, dir.y * d.x + dir.x * d.y);
+    strength *= a.z;
+  }
+#endif
+  s->anisotropy = 0.0f;
+  if (strength > 0.0f) {
+    float3 t, b;
+    tangent_frame(scene, tv, u, v, n_front, &t, &b);
+    float3 d = dir.x * t + dir.y * b;
+    d -= s->ns * dot(s->ns, d);
+    const float len = length(d);
+    if (len > 1e-6f) s->aniso_t = d / len, s->anisotropy = fmin(strength, 1.0f);
+  }
+#endif
+#if WP_FEATURE_IRIDESCENCE
+  s->iridescence = m->iridescence.x * texel_or_one(scene, m->textures3.y, uv).x;
+  s->iridescence_ior = m->iridescence.y;
+  s->iridescence_thickness = m->iridescence.w;
+#if WP_FEATURE_TEXTURES
+  if (m->textures3.z >= 0)
+    s->iridescence_thickness =
+        mix(m->iridescence.z, m->iridescence.w, texture_sample(scene, m->textures3.z, uv).y);
+#endif
+#endif
+#if WP_FEATURE_DIFFUSE_TRANSMISSION
+  s->diffuse_transmission = m->diffuse_transmission.w * texel_or_one(scene, m->textures3.w, uv).w;
+  s->dt_color = m->diffuse_transmission.xyz * texel_or_one(scene, m->textures4.x, uv).xyz;
+#endif
+#if WP_FEATURE_DISPERSION
+  s->dispersion = m->extra.w;
+  s->channel = 0u; /* the path's, set by the integrator (shade_hit, surface_load) */
+#endif
+}
+#endif
 
 /* Geometry and material at a hit of a ray with direction ray_d on triangle tv at barycentrics
  * (u, v). *front tells whether the ray hit the front (counter-clockwise) side; both normals are
@@ -126,14 +225,16 @@ static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u,
   s.ng = len > 0.0f ? n / len : -ray_d; /* a degenerate triangle faces the ray */
   *front = dot(s.ng, ray_d) < 0.0f;
   if (!*front) s.ng = -s.ng;
-#if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS
+#if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS || WP_BSDF_EXTENSIONS
   const float4 uv = interpolate4(scene->uvs, tv, u, v);
 #else
   const float4 uv = (float4)(0.0f);
 #endif
-  s.ns = normalize(interpolate3(scene->normals, tv, u, v));
+  const float3 n_front = normalize(interpolate3(scene->normals, tv, u, v));
+  s.ns = n_front;
 #if WP_FEATURE_NORMAL_MAPS
-  if (m->textures0.z >= 0) s.ns = normal_mapped(scene, m, tv, u, v, uv, s.ns);
+  if (m->textures0.z >= 0)
+    s.ns = normal_mapped(scene, m->textures0.z, m->extra.x, tv, u, v, uv, n_front);
 #endif
   /* Computed on the front side's frame; turned, like the interpolated normal, to the side the
    * ray sees (for a back-side hit that mirrors the whole front-side frame). */
@@ -145,6 +246,9 @@ static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u,
    * reflect into the surface. Fall back to the true normal there. */
   if (!(dot(s.ns, -ray_d) > 1e-4f)) s.ns = s.ng;
   resolve_material(scene, m, tv, u, v, uv, &s);
+#if WP_BSDF_EXTENSIONS
+  resolve_extensions(scene, m, tv, u, v, uv, n_front, -ray_d, &s);
+#endif
   s.flags = *front ? WP_SURF_FRONT : 0u;
 #if WP_FEATURE_UNLIT
   if (m->flags.x & WP_MAT_UNLIT) s.flags |= WP_SURF_UNLIT;

@@ -9,9 +9,34 @@
 static inline void surface_store(Paths paths, uint slot, const Surface* s) {
   path_store_surf_p(paths, slot, s->p, s->p_scale);
   path_store_surf_ng(paths, slot, s->ng, s->specular);
+#if WP_FEATURE_CLEARCOAT
+  path_store_surf_ns(paths, slot, s->ns, s->clearcoat_roughness);
+  path_store_surf_coat(paths, slot, s->nc, s->clearcoat);
+#else
   path_set_surf_ns(paths, slot, s->ns);
+#endif
   path_store_surf_color(paths, slot, s->color, s->metallic);
   path_store_surf_params(paths, slot, s->roughness, s->ior, s->transmission, s->flags);
+#if WP_FEATURE_SPECULAR
+  path_set_surf_specular_color(paths, slot, s->specular_color);
+#endif
+#if WP_FEATURE_DISPERSION
+  path_set_surf_dispersion(paths, slot, s->dispersion);
+#endif
+#if WP_FEATURE_SHEEN
+  path_store_surf_sheen(paths, slot, s->sheen_color, s->sheen_roughness);
+#endif
+#if WP_FEATURE_ANISOTROPY
+  path_store_surf_aniso(paths, slot, s->aniso_t, s->anisotropy);
+#endif
+#if WP_FEATURE_IRIDESCENCE
+  path_set_surf_iridescence(paths, slot, s->iridescence);
+  path_set_surf_iridescence_ior(paths, slot, s->iridescence_ior);
+  path_set_surf_iridescence_thickness(paths, slot, s->iridescence_thickness);
+#endif
+#if WP_FEATURE_DIFFUSE_TRANSMISSION
+  path_store_surf_dtrans(paths, slot, s->dt_color, s->diffuse_transmission);
+#endif
 }
 
 static inline Surface surface_load(Paths paths, uint slot) {
@@ -27,6 +52,35 @@ static inline Surface surface_load(Paths paths, uint slot) {
   s.ior = path_surf_ior(paths, slot);
   s.transmission = path_surf_transmission(paths, slot);
   s.flags = path_surf_flags(paths, slot);
+#if WP_FEATURE_SPECULAR
+  s.specular_color = path_surf_specular_color(paths, slot);
+#endif
+#if WP_FEATURE_DISPERSION
+  s.dispersion = path_surf_dispersion(paths, slot);
+  s.channel = (path_flags(paths, slot) & WP_PATH_CHANNEL_MASK) >> WP_PATH_CHANNEL_SHIFT;
+#endif
+#if WP_FEATURE_CLEARCOAT
+  s.nc = path_surf_coat_normal(paths, slot);
+  s.clearcoat = path_surf_clearcoat(paths, slot);
+  s.clearcoat_roughness = path_surf_clearcoat_roughness(paths, slot);
+#endif
+#if WP_FEATURE_SHEEN
+  s.sheen_color = path_surf_sheen_color(paths, slot);
+  s.sheen_roughness = path_surf_sheen_roughness(paths, slot);
+#endif
+#if WP_FEATURE_ANISOTROPY
+  s.aniso_t = path_surf_aniso_t(paths, slot);
+  s.anisotropy = path_surf_anisotropy(paths, slot);
+#endif
+#if WP_FEATURE_IRIDESCENCE
+  s.iridescence = path_surf_iridescence(paths, slot);
+  s.iridescence_ior = path_surf_iridescence_ior(paths, slot);
+  s.iridescence_thickness = path_surf_iridescence_thickness(paths, slot);
+#endif
+#if WP_FEATURE_DIFFUSE_TRANSMISSION
+  s.dt_color = path_surf_dt_color(paths, slot);
+  s.diffuse_transmission = path_surf_diffuse_transmission(paths, slot);
+#endif
   return s;
 }
 

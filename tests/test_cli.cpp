@@ -267,4 +267,52 @@ TEST_F(Cli, RendersBothImagesWithSettingsAndJson) {
     EXPECT_NE(last.find(key), std::string::npos) << key << " in " << last;
 }
 
+// --variant (KHR_materials_variants): listed in the help; a name the file lacks is a one-line
+// error naming the file's variants (or saying it has none), before any device work.
+TEST_F(Cli, UnknownMaterialVariantIsAnError) {
+  const CliRun help = run("render --help");
+  EXPECT_NE(help.out.find("--variant"), std::string::npos);
+  expect_error(run("render '" + cornell() + "' --variant red"),
+               "no material variant 'red': the file has no variants (KHR_materials_variants)");
+  std::ofstream(dir_ / "scene.gltf") << R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],)"
+                                        R"("scene":0,"extensionsUsed":["KHR_materials_variants"],)"
+                                        R"("extensions":{"KHR_materials_variants":{"variants":[)"
+                                        R"({"name":"gold"},{"name":"silver"}]}}})";
+  expect_error(run("render scene.gltf --variant bronze"),
+               "no material variant 'bronze': the file's variants are 'gold', 'silver'");
+}
+
+// Two variants of one file are two scenes: their films do not merge (the render key's scene
+// digest differs), while two parts of one variant do; the EXR header names the variant.
+TEST_F(Cli, MaterialVariantsAreDifferentRenders) {
+  // One triangle in front of the default camera; its material is red, or under "green" green.
+  std::ofstream(dir_ / "scene.gltf")
+      << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+         R"("nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},)"
+         R"("material":0,"extensions":{"KHR_materials_variants":{"mappings":[)"
+         R"({"material":1,"variants":[1]}]}}}]}],)"
+         R"("materials":[{"emissiveFactor":[1,0,0]},{"emissiveFactor":[0,1,0]}],)"
+         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",)"
+         R"("min":[0,0,0],"max":[1,1,0]}],"bufferViews":[{"buffer":0,"byteLength":36}],)"
+         R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)"
+         R"(AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],)"
+         R"("extensionsUsed":["KHR_materials_variants"],"extensions":{"KHR_materials_variants":)"
+         R"({"variants":[{"name":"red"},{"name":"green"}]}}})";
+  for (const char* args :
+       {"--variant red --samples 0:1 -o red0.wpfilm -o red0.exr",
+        "--variant red --samples 1:2 -o red1.wpfilm",
+        "--variant green --samples 1:2 -o green1.wpfilm", "--samples 1:2 -o plain1.wpfilm"}) {
+    const CliRun r = run(std::string("render scene.gltf --width 8 --height 6 -q ") + args);
+    ASSERT_EQ(r.status, 0) << args << ": " << r.err;
+  }
+  EXPECT_EQ(wp::read_exr_attributes((dir_ / "red0.exr").string()).at("wavepath:variant"), "red");
+  const CliRun same = run("merge red0.wpfilm red1.wpfilm -o red.exr");
+  EXPECT_EQ(same.status, 0) << same.err;
+  for (const char* other : {"green1.wpfilm", "plain1.wpfilm"}) {
+    const CliRun r = run(std::string("merge red0.wpfilm ") + other + " -o mixed.exr");
+    EXPECT_NE(r.status, 0) << other;
+    EXPECT_NE(r.err.find("does not merge"), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace

@@ -96,7 +96,7 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   // be the --checkpoint file, which the render replaces).
   std::optional<wp::Film> resume;
   if (!cli.resume.empty()) resume = wp::Film::read(cli.resume);
-  const wp::Scene scene = wp::load_gltf(cli.scene);
+  const wp::Scene scene = wp::load_gltf(cli.scene, wp::LoadOptions{cli.variant});
   // Known now, not only once the kernels are built and the BVH is made.
   if (mine.camera >= 0 && static_cast<std::size_t>(mine.camera) >= scene.cameras.size())
     throw wp::Error("--camera " + std::to_string(mine.camera) + ": the scene has " +
@@ -237,6 +237,7 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   result.report.ranks = ranks.size();
   auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
   attributes["wavepath:render_key"] = result.film.info().key;
+  if (!cli.variant.empty()) attributes["wavepath:variant"] = cli.variant;
   write_outputs(cli, result.film, attributes);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

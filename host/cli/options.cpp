@@ -157,10 +157,14 @@ void add_output_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
       ->capture_default_str();
 }
 
-// The camera and the light around the scene.
+// The camera, the materials and the light around the scene.
 void add_scene_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& settings) {
   app->add_option("--camera", settings.camera,
                   "Camera index in node order [default: the first, else one framing the scene]");
+  app->add_option("--variant", cli.variant,
+                  "Material variant (KHR_materials_variants) by name: each primitive gets its "
+                  "material for that variant, or its own where it has none; an unknown name "
+                  "is an error listing the file's variants [default: the file's own materials]");
   app->add_option("--env-color", cli.env_color,
                   "Constant background radiance R,G,B (linear) [default: 0,0,0]")
       ->delimiter(',')

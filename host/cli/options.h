@@ -15,6 +15,7 @@ namespace wp::cli {
 
 struct CliOptions {
   std::string scene;
+  std::string variant;  // --variant: KHR_materials_variants name ("": the file's own materials)
   std::vector<std::string> parts;  // merge: the .wpfilm files
   std::vector<std::string> outputs;
   std::string samples;  // --samples A:B

@@ -76,7 +76,7 @@ dev::Material device_material(const Material& m) {
   d.params = {m.metallic, m.roughness, m.ior, m.transmission};
   d.volume =
       f4(m.attenuation_color, m.attenuation_distance > 0.0f ? m.attenuation_distance : INFINITY);
-  d.extra = {m.normal_scale, m.thickness, m.specular, 0.0f};
+  d.extra = {m.normal_scale, m.thickness, 0.0f, m.dispersion};
   dev::uint flags = 0;
   if (m.double_sided) flags |= WP_MAT_DOUBLE_SIDED;
   if (m.alpha_mode == AlphaMode::kMask) flags |= WP_MAT_ALPHA_MASK;
@@ -86,7 +86,21 @@ dev::Material device_material(const Material& m) {
   d.flags = {flags, 0u, 0u, 0u};
   d.textures0 = {m.base_color_texture, m.metallic_roughness_texture, m.normal_texture,
                  m.emissive_texture};
-  d.textures1 = {m.transmission_texture, -1, -1, -1};
+  d.textures1 = {m.transmission_texture, m.specular_texture, m.specular_color_texture,
+                 m.clearcoat_texture};
+  d.textures2 = {m.clearcoat_roughness_texture, m.clearcoat_normal_texture, m.sheen_color_texture,
+                 m.sheen_roughness_texture};
+  d.textures3 = {m.anisotropy_texture, m.iridescence_texture, m.iridescence_thickness_texture,
+                 m.diffuse_transmission_texture};
+  d.textures4 = {m.diffuse_transmission_color_texture, -1, -1, -1};
+  d.specular = f4(m.specular_color, m.specular);
+  d.clearcoat = {m.clearcoat, m.clearcoat_roughness, m.clearcoat_normal_scale, 0.0f};
+  d.sheen = f4(m.sheen_color, m.sheen_roughness);
+  d.anisotropy = {m.anisotropy_strength, std::cos(m.anisotropy_rotation),
+                  std::sin(m.anisotropy_rotation), 0.0f};
+  d.iridescence = {m.iridescence, m.iridescence_ior, m.iridescence_thickness_min,
+                   m.iridescence_thickness_max};
+  d.diffuse_transmission = f4(m.diffuse_transmission_color, m.diffuse_transmission);
   return d;
 }
 

@@ -15,7 +15,7 @@ static_assert(sizeof(IsectTri) == 48);
 static_assert(sizeof(float8) == 32 && alignof(float8) == 32);
 static_assert(sizeof(BvhNode8) == 224 && offsetof(BvhNode8, child) == 192);
 static_assert(sizeof(TriBlock4) == 176 && offsetof(TriBlock4, prim) == 144);
-static_assert(sizeof(Material) == 128);
+static_assert(sizeof(Material) == 272);
 static_assert(offsetof(Material, textures0) == 96);
 static_assert(sizeof(TextureRef) == 48);
 static_assert(sizeof(TextureImage) == 16);

@@ -20,9 +20,19 @@ struct SceneFeatures {
   bool normal_maps = true;
   bool alpha = true;
   bool unlit = true;
-  bool glossy = true;  // a scattering material with metallic > 0, specular > 0 or transmission
+  // A scattering material with metallic > 0, specular > 0, transmission or one of the layered
+  // extensions below (they need the full BSDF, kernels/bsdf.h).
+  bool glossy = true;
   bool transmission = true;
   bool volume = true;
+  // The material extensions; each only for scattering (not unlit) materials that use it.
+  bool specular = true;     // KHR_materials_specular: a colour other than white, or a texture
+  bool clearcoat = true;    // clearcoatFactor > 0
+  bool sheen = true;        // a sheen colour other than black
+  bool anisotropy = true;   // anisotropyStrength > 0
+  bool iridescence = true;  // iridescenceFactor > 0
+  bool diffuse_transmission = true;  // diffuseTransmissionFactor > 0
+  bool dispersion = true;            // dispersion > 0 on a transmissive material with a volume
 
   static SceneFeatures all() { return {}; }
   // The features `scene` uses; `has_environment_map` tells whether the render has a map.

@@ -1,10 +1,24 @@
 #include "host/render/path_state.h"
 
+#include <sstream>
+#include <string>
+
 #include "host/util/error.h"
 
 namespace wp {
 
-PathStateLayout path_state_layout(std::size_t capacity, bool aov) {
+namespace {
+// Whether `features` names (space-separated WP_FEATURE_* macros) one the program is built with.
+bool uses_any(const SceneFeatures& scene, const std::string& features) {
+  std::istringstream names(features);
+  for (std::string name; names >> name;)
+    for (const auto& [macro, on] : scene.flags())
+      if (macro == name && on) return true;
+  return false;
+}
+}  // namespace
+
+PathStateLayout path_state_layout(std::size_t capacity, bool aov, const SceneFeatures& features) {
   using namespace dev;
   PathStateLayout s;
   std::size_t offset = 0;
@@ -18,7 +32,10 @@ PathStateLayout path_state_layout(std::size_t capacity, bool aov) {
   };
 #define WP_PATH_FIELD(type, name, description) s.layout.name = place(sizeof(type));
 #define WP_PATH_AOV_FIELD(type, name, description) s.layout.name = place(aov ? sizeof(type) : 0);
+#define WP_PATH_OPT_FIELD(needs, type, name, description) \
+  s.layout.name = place(uses_any(features, needs) ? sizeof(type) : 0);
 #include "kernels/shared/path_state.def"
+#undef WP_PATH_OPT_FIELD
 #undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
   s.layout.capacity = static_cast<uint>(capacity);

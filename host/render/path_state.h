@@ -4,6 +4,7 @@
 
 #include <cstddef>
 
+#include "host/device/scene_features.h"
 #include "kernels/shared/types.h"
 
 namespace wp {
@@ -14,7 +15,9 @@ struct PathStateLayout {
   std::size_t bytes_per_path = 0;
 };
 
-// `aov`: with the AOV fields (WP_PATH_AOV_FIELD), else those take no memory.
-PathStateLayout path_state_layout(std::size_t capacity, bool aov = false);
+// `aov`: with the AOV fields (WP_PATH_AOV_FIELD), else those take no memory; the fields of
+// material extensions (WP_PATH_OPT_FIELD) take memory only when `features` has one they name.
+PathStateLayout path_state_layout(std::size_t capacity, bool aov = false,
+                                  const SceneFeatures& features = SceneFeatures::all());
 
 }  // namespace wp

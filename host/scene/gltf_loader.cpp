@@ -29,11 +29,16 @@ namespace wp {
 namespace {
 
 const std::set<std::string> kSupportedExtensions = {
-    "KHR_lights_punctual",    "KHR_materials_emissive_strength",
-    "KHR_materials_ior",      "KHR_materials_transmission",
-    "KHR_materials_unlit",    "KHR_materials_volume",
-    "KHR_materials_specular", "KHR_mesh_quantization",
-    "KHR_texture_transform"};
+    "KHR_lights_punctual",        "KHR_materials_anisotropy",
+    "KHR_materials_clearcoat",    "KHR_materials_diffuse_transmission",
+    "KHR_materials_dispersion",   "KHR_materials_emissive_strength",
+    "KHR_materials_ior",          "KHR_materials_iridescence",
+    "KHR_materials_sheen",        "KHR_materials_specular",
+    "KHR_materials_transmission", "KHR_materials_unlit",
+    "KHR_materials_variants",     "KHR_materials_volume",
+    "KHR_mesh_quantization",      "KHR_texture_transform"};
+
+constexpr const char* kVariants = "KHR_materials_variants";
 
 // tinygltf's messages span lines; wavepath's errors are one line.
 std::vector<std::string> lines(const std::string& text) {
@@ -189,11 +194,69 @@ void check_extensions(const tinygltf::Model& model, const std::string& path,
       warnings->push_back(path + ": ignoring unsupported extension " + name);
 }
 
+// A name from the file for a one-line message: control characters become '?'.
+std::string printable(const std::string& name) {
+  std::string out = name.substr(0, 64);
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return out;
+}
+
+// KHR_materials_variants' variant names (the root extension's "variants"), in file order; none
+// without the extension.
+std::vector<std::string> variant_names(const tinygltf::Model& model) {
+  std::vector<std::string> names;
+  const auto it = model.extensions.find(kVariants);
+  if (it == model.extensions.end()) return names;
+  const std::string at = std::string(kVariants) + ": ";
+  if (!it->second.IsObject()) throw Error(at + "not an object");
+  if (!it->second.Has("variants") || !it->second.Get("variants").IsArray())
+    throw Error(at + "variants is not an array");
+  const tinygltf::Value& variants = it->second.Get("variants");
+  for (int i = 0; i < static_cast<int>(variants.ArrayLen()); ++i) {
+    const tinygltf::Value& v = variants.Get(i);
+    if (!v.IsObject() || !v.Has("name") || !v.Get("name").IsString())
+      throw Error(at + "variant " + std::to_string(i) + " has no name");
+    names.push_back(v.Get("name").Get<std::string>());
+  }
+  return names;
+}
+
+// The index of variant `name` among `names`; -1 for "" (no variant). Throws wp::Error listing the
+// names when there is no such variant.
+int variant_index(const std::vector<std::string>& names, const std::string& name) {
+  if (name.empty()) return -1;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<int>(i);
+  std::string known;
+  for (const std::string& n : names) known += (known.empty() ? "'" : ", '") + printable(n) + "'";
+  throw Error("no material variant '" + printable(name) + "': " +
+              (names.empty() ? std::string("the file has no variants (KHR_materials_variants)")
+                             : "the file's variants are " + known));
+}
+
+// The texture whose TEXCOORD set generated tangents follow: the normal texture's, else the
+// clearcoat normal texture's, else the anisotropy texture's; -1 when there is none.
+int tangent_texture(const Material& m) {
+  return m.normal_texture >= 0             ? m.normal_texture
+         : m.clearcoat_normal_texture >= 0 ? m.clearcoat_normal_texture
+                                           : m.anisotropy_texture;
+}
+
+// Whether a material reads a tangent frame: for a normal texture (the base's or the clearcoat's)
+// or anisotropy (its direction is given in tangent space).
+bool needs_tangents(const Material& m) {
+  return m.normal_texture >= 0 || m.clearcoat_normal_texture >= 0 || m.anisotropy_strength > 0.0f ||
+         m.anisotropy_texture >= 0;
+}
+
 // Fills the scene from the node tree of one glTF scene. Messages lack the file name; load_gltf
 // adds it.
 class SceneBuilder {
  public:
-  SceneBuilder(const tinygltf::Model& model, Scene& scene) : model_(model), scene_(scene) {}
+  // `variant`: the index of the selected material variant, -1 for none.
+  SceneBuilder(const tinygltf::Model& model, Scene& scene, int variant)
+      : model_(model), scene_(scene), variant_(variant) {}
 
   void build(int scene_index);
 
@@ -201,12 +264,14 @@ class SceneBuilder {
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
   std::uint32_t material_index(int material);
+  int primitive_material(const tinygltf::Primitive& p) const;
   gltf::VertexNeeds vertex_needs(std::uint32_t material) const;
   void warn_once(int mesh, std::size_t primitive, const std::string& message);
   static std::string revisit_message(const std::vector<int>& parent, int node, int from);
 
   const tinygltf::Model& model_;
   Scene& scene_;
+  int variant_;
   std::optional<std::uint32_t> default_material_;
   gltf::VertexNeeds file_needs_;  // uv1 and tangents: whether the scene keeps them at all
   std::set<std::pair<int, std::size_t>> warned_;  // (mesh, primitive): instances warn once
@@ -217,7 +282,7 @@ class SceneBuilder {
 void SceneBuilder::build(int scene_index) {
   const tinygltf::Scene& scene = model_.scenes[static_cast<std::size_t>(scene_index)];
   for (const TextureRef& t : scene_.textures) file_needs_.uv1 |= t.texcoord == 1;
-  for (const Material& m : scene_.materials) file_needs_.tangents |= m.normal_texture >= 0;
+  for (const Material& m : scene_.materials) file_needs_.tangents |= needs_tangents(m);
   constexpr int kUnvisited = -2, kRoot = -1;
   std::vector<int> parent(model_.nodes.size(), kUnvisited);
   struct Item {
@@ -284,7 +349,7 @@ void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
       continue;
     }
     try {
-      const std::uint32_t material = material_index(p.material);
+      const std::uint32_t material = material_index(primitive_material(p));
       const std::size_t leftover =
           gltf::append_primitive(model_, p, world, material, vertex_needs(material), scene_);
       if (leftover != 0)
@@ -312,12 +377,54 @@ std::uint32_t SceneBuilder::material_index(int material) {
   return *default_material_;
 }
 
+// KHR_materials_variants: the material of primitive `p` under the selected variant, that of the
+// mapping naming it, else p.material. The mappings are checked whether or not a variant is
+// selected: each names an existing material and existing variants, each variant at most once.
+int SceneBuilder::primitive_material(const tinygltf::Primitive& p) const {
+  const auto it = p.extensions.find(kVariants);
+  if (it == p.extensions.end()) return p.material;
+  const std::string at = std::string(kVariants) + ": ";
+  const tinygltf::Value& ext = it->second;
+  if (!ext.IsObject() || !ext.Has("mappings") || !ext.Get("mappings").IsArray())
+    throw Error(at + "mappings is not an array");
+  const tinygltf::Value& mappings = ext.Get("mappings");
+  std::vector<bool> mapped(scene_.variants.size(), false);
+  int material = p.material;
+  for (int k = 0; k < static_cast<int>(mappings.ArrayLen()); ++k) {
+    const tinygltf::Value& m = mappings.Get(k);
+    const std::string where = at + "mapping " + std::to_string(k) + ": ";
+    if (!m.IsObject() || !m.Has("material") || !m.Get("material").IsInt())
+      throw Error(where + "no material index");
+    const int mat = m.Get("material").GetNumberAsInt();
+    if (mat < 0 || static_cast<std::size_t>(mat) >= model_.materials.size())
+      throw Error(where + "material " + std::to_string(mat) + " does not exist");
+    if (!m.Has("variants") || !m.Get("variants").IsArray())
+      throw Error(where + "variants is not an array");
+    const tinygltf::Value& variants = m.Get("variants");
+    for (int j = 0; j < static_cast<int>(variants.ArrayLen()); ++j) {
+      const tinygltf::Value& v = variants.Get(j);
+      if (!v.IsInt()) throw Error(where + "a variant index is not an integer");
+      const int index = v.GetNumberAsInt();
+      if (index < 0 || static_cast<std::size_t>(index) >= mapped.size())
+        throw Error(where + "variant " + std::to_string(index) + " does not exist (the file has " +
+                    std::to_string(mapped.size()) + " variants)");
+      if (mapped[static_cast<std::size_t>(index)])
+        throw Error(where + "variant " + std::to_string(index) + " is mapped twice");
+      mapped[static_cast<std::size_t>(index)] = true;
+      if (index == variant_) material = mat;
+    }
+  }
+  return material;
+}
+
 // TEXCOORD_1 and tangents are kept for every vertex when any texture reads set 1 or any material
-// has a normal texture, and for none otherwise (scene.h).
+// needs a tangent frame (a normal texture, a clearcoat normal texture, anisotropy), and for none
+// otherwise (scene.h). Generated tangents follow the set of the primitive's normal texture, else
+// of its clearcoat normal or anisotropy texture.
 gltf::VertexNeeds SceneBuilder::vertex_needs(std::uint32_t material) const {
   gltf::VertexNeeds needs = file_needs_;
-  const int normal = scene_.materials[material].normal_texture;
-  if (normal >= 0) needs.tangent_uv = scene_.textures[static_cast<std::size_t>(normal)].texcoord;
+  const int texture = tangent_texture(scene_.materials[material]);
+  if (texture >= 0) needs.tangent_uv = scene_.textures[static_cast<std::size_t>(texture)].texcoord;
   return needs;
 }
 
@@ -344,7 +451,7 @@ void compute_bounds(Scene& scene) {
 
 }  // namespace
 
-Scene load_gltf(const std::string& path) {
+Scene load_gltf(const std::string& path, const LoadOptions& options) {
   Scene scene;
   scene.source = path;
   const tinygltf::Model model = parse(path, &scene.warnings, &scene.digest);
@@ -364,10 +471,17 @@ Scene load_gltf(const std::string& path) {
     const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (static_cast<std::size_t>(scene_index) >= model.scenes.size())
       throw Error("default scene " + std::to_string(scene_index) + " does not exist");
+    scene.variants = variant_names(model);
+    const int variant = variant_index(scene.variants, options.variant);
+    if (variant >= 0) {  // another variant, another scene (the render key)
+      scene.variant = options.variant;
+      const std::string tag = "KHR_materials_variants:" + options.variant;
+      scene.digest = fnv1a64(tag.data(), tag.size(), scene.digest);
+    }
     gltf::TextureTable textures(model, scene);
     for (std::size_t i = 0; i < model.materials.size(); ++i)
       scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i), textures));
-    SceneBuilder(model, scene).build(scene_index);
+    SceneBuilder(model, scene, variant).build(scene_index);
     // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
     if (scene.triangle_count() == 0)
       scene.warnings.push_back(path + ": scene " + std::to_string(scene_index) +

@@ -7,6 +7,14 @@
 
 namespace wp {
 
+// How to load a file, beyond what it says itself.
+struct LoadOptions {
+  // KHR_materials_variants: the name of the variant whose materials the primitives get (each
+  // primitive's mapping for it, or its own material where it has none); empty: the file's own
+  // materials. A name the file does not define is an error listing the names it does.
+  std::string variant;
+};
+
 // Loads the default scene (or scene 0) of a glTF file: the node hierarchy with full transforms,
 // every triangle primitive, materials, KHR_lights_punctual lights and cameras.
 // Throws wp::Error naming the file and the cause when the file is missing, unreadable or
@@ -15,7 +23,7 @@ namespace wp {
 // when it requires an extension wavepath does not support. Unsupported optional extensions and
 // non-triangle primitives are skipped with a line in Scene::warnings. A scene without triangles
 // is valid glTF: it loads, with a warning, and bounds at the origin.
-Scene load_gltf(const std::string& path);
+Scene load_gltf(const std::string& path, const LoadOptions& options = {});
 
 // A perspective camera that frames the scene's bounds (for files without cameras): it looks at
 // the centre of the bounds along -Z from in front (+Z side), slightly from above, with a 45 degree

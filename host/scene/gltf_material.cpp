@@ -10,7 +10,9 @@
 namespace wp::gltf {
 namespace {
 
-// The object of material extension `name`, or null when the material does not use it.
+// The object of material extension `name`, or null when the material does not use it. (tinygltf
+// drops extension values that are not objects, and empty arrays and objects inside them: such
+// fields read as absent.)
 const tinygltf::Value* extension(const tinygltf::Material& m, const char* name,
                                  const std::string& where) {
   const auto it = m.extensions.find(name);
@@ -19,15 +21,49 @@ const tinygltf::Value* extension(const tinygltf::Material& m, const char* name,
   return &it->second;
 }
 
-// A number from a material extension's object, or `fallback` when the extension or the field is
-// absent.
-float extension_number(const tinygltf::Material& m, const char* name, const char* field,
-                       float fallback, const std::string& where) {
-  const tinygltf::Value* ext = extension(m, name, where);
+// A number field of extension object `ext` (may be null), or `fallback` when either is absent.
+float number(const tinygltf::Value* ext, const char* name, const char* field, float fallback,
+             const std::string& where) {
   if (!ext || !ext->Has(field)) return fallback;
   const tinygltf::Value& v = ext->Get(field);
   if (!v.IsNumber()) throw Error(where + ": " + name + "." + field + " is not a number");
   return finite(v.GetNumberAsDouble(), where, field);
+}
+
+// A number field of `ext` within [lo, hi], or `fallback`.
+float number_in(const tinygltf::Value* ext, const char* name, const char* field, float fallback,
+                double lo, double hi, const std::string& where) {
+  if (!ext || !ext->Has(field)) return fallback;
+  return in_range(number(ext, name, field, fallback, where), lo, hi, where, field);
+}
+
+// An RGB field of `ext` with every component within [lo, hi], or `fallback`.
+glm::vec3 color_in(const tinygltf::Value* ext, const char* field, glm::vec3 fallback, double lo,
+                   double hi, const std::string& where) {
+  if (!ext || !ext->Has(field)) return fallback;
+  const tinygltf::Value& c = ext->Get(field);
+  if (!c.IsArray() || c.ArrayLen() != 3) throw Error(where + ": " + field + " needs 3 numbers");
+  glm::vec3 out;
+  for (int i = 0; i < 3; ++i) {
+    if (!c.Get(i).IsNumber()) throw Error(where + ": " + field + " is not numbers");
+    out[i] = in_range(c.Get(i).GetNumberAsDouble(), lo, hi, where, field);
+  }
+  return out;
+}
+
+// The textureInfo field `field` of `ext` added to `textures` (-1: absent or unusable).
+int texture(const tinygltf::Value* ext, const char* field, bool srgb, TextureTable& textures,
+            const std::string& where) {
+  if (!ext || !ext->Has(field)) return -1;
+  const std::string at = where + ": " + field;
+  return textures.add(texture_info(ext->Get(field), at), srgb, at);
+}
+
+// A number from material extension `name`, or `fallback` when the extension or the field is
+// absent.
+float extension_number(const tinygltf::Material& m, const char* name, const char* field,
+                       float fallback, const std::string& where) {
+  return number(extension(m, name, where), name, field, fallback, where);
 }
 
 AlphaMode alpha_mode(const std::string& mode, const std::string& where) {
@@ -91,14 +127,93 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
       1.0, where, "transmissionFactor");
   out.unlit = in.extensions.count("KHR_materials_unlit") != 0;
   read_volume(in, where, out);
-  // KHR_materials_specular: the factor scales the dielectric Fresnel term (kernels/bsdf.h);
-  // specularColorFactor and the two textures are not applied yet.
-  out.specular =
-      in_range(extension_number(in, "KHR_materials_specular", "specularFactor", 1.0f, where), 0.0,
-               1.0, where, "specularFactor");
 }
 
-// Colour textures (base colour, emissive) are sRGB-encoded; the others hold linear data.
+// KHR_materials_specular: the factor scales the dielectric Fresnel term (F0 and F90), the colour
+// tints F0 (kernels/bsdf.h). specularColorFactor may exceed 1: the product with F0 is clamped.
+void read_specular(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
+                   Material& out) {
+  const char* kName = "KHR_materials_specular";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  out.specular = number_in(ext, kName, "specularFactor", 1.0f, 0.0, 1.0, where);
+  out.specular_color = color_in(ext, "specularColorFactor", glm::vec3(1.0f), 0.0, INFINITY, where);
+  out.specular_texture = texture(ext, "specularTexture", false, textures, where);
+  out.specular_color_texture = texture(ext, "specularColorTexture", true, textures, where);
+}
+
+// KHR_materials_clearcoat: a dielectric coat (ior 1.5) of its own roughness and normal texture.
+void read_clearcoat(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
+                    Material& out) {
+  const char* kName = "KHR_materials_clearcoat";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  out.clearcoat = number_in(ext, kName, "clearcoatFactor", 0.0f, 0.0, 1.0, where);
+  out.clearcoat_roughness =
+      number_in(ext, kName, "clearcoatRoughnessFactor", 0.0f, 0.0, 1.0, where);
+  out.clearcoat_texture = texture(ext, "clearcoatTexture", false, textures, where);
+  out.clearcoat_roughness_texture =
+      texture(ext, "clearcoatRoughnessTexture", false, textures, where);
+  if (ext && ext->Has("clearcoatNormalTexture"))  // a normalTextureInfo: its scale
+    out.clearcoat_normal_scale =
+        number(&ext->Get("clearcoatNormalTexture"), "clearcoatNormalTexture", "scale", 1.0f, where);
+  out.clearcoat_normal_texture = texture(ext, "clearcoatNormalTexture", false, textures, where);
+}
+
+// KHR_materials_sheen: a Charlie sheen lobe, off while the colour is black.
+void read_sheen(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
+                Material& out) {
+  const char* kName = "KHR_materials_sheen";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  out.sheen_color = color_in(ext, "sheenColorFactor", glm::vec3(0.0f), 0.0, 1.0, where);
+  out.sheen_roughness = number_in(ext, kName, "sheenRoughnessFactor", 0.0f, 0.0, 1.0, where);
+  out.sheen_color_texture = texture(ext, "sheenColorTexture", true, textures, where);
+  out.sheen_roughness_texture = texture(ext, "sheenRoughnessTexture", false, textures, where);
+}
+
+// KHR_materials_anisotropy: strength in [0, 1]; the rotation (radians, from the tangent toward
+// the bitangent) may be any angle.
+void read_anisotropy(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
+                     Material& out) {
+  const char* kName = "KHR_materials_anisotropy";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  out.anisotropy_strength = number_in(ext, kName, "anisotropyStrength", 0.0f, 0.0, 1.0, where);
+  out.anisotropy_rotation = number(ext, kName, "anisotropyRotation", 0.0f, where);
+  out.anisotropy_texture = texture(ext, "anisotropyTexture", false, textures, where);
+}
+
+// KHR_materials_iridescence: a thin film of index iridescenceIor (at least 1) and a thickness
+// between the minimum and the maximum (nanometres, the maximum without a thickness texture).
+void read_iridescence(const tinygltf::Material& in, const std::string& where,
+                      TextureTable& textures, Material& out) {
+  const char* kName = "KHR_materials_iridescence";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  out.iridescence = number_in(ext, kName, "iridescenceFactor", 0.0f, 0.0, 1.0, where);
+  out.iridescence_ior = number_in(ext, kName, "iridescenceIor", 1.3f, 1.0, INFINITY, where);
+  out.iridescence_thickness_min =
+      number_in(ext, kName, "iridescenceThicknessMinimum", 100.0f, 0.0, INFINITY, where);
+  out.iridescence_thickness_max =
+      number_in(ext, kName, "iridescenceThicknessMaximum", 400.0f, 0.0, INFINITY, where);
+  out.iridescence_texture = texture(ext, "iridescenceTexture", false, textures, where);
+  out.iridescence_thickness_texture =
+      texture(ext, "iridescenceThicknessTexture", false, textures, where);
+}
+
+// KHR_materials_diffuse_transmission: the share of the diffuse lobe transmitted, and its colour.
+void read_diffuse_transmission(const tinygltf::Material& in, const std::string& where,
+                               TextureTable& textures, Material& out) {
+  const char* kName = "KHR_materials_diffuse_transmission";
+  const tinygltf::Value* ext = extension(in, kName, where);
+  out.diffuse_transmission =
+      number_in(ext, kName, "diffuseTransmissionFactor", 0.0f, 0.0, 1.0, where);
+  out.diffuse_transmission_color =
+      color_in(ext, "diffuseTransmissionColorFactor", glm::vec3(1.0f), 0.0, 1.0, where);
+  out.diffuse_transmission_texture =
+      texture(ext, "diffuseTransmissionTexture", false, textures, where);
+  out.diffuse_transmission_color_texture =
+      texture(ext, "diffuseTransmissionColorTexture", true, textures, where);
+}
+
+// The core textures and KHR_materials_transmission's. Colour textures (base colour, emissive, and
+// the extensions' colour textures) are sRGB-encoded; the others hold linear data.
 void read_textures(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
                    Material& out) {
   const tinygltf::PbrMetallicRoughness& pbr = in.pbrMetallicRoughness;
@@ -111,11 +226,13 @@ void read_textures(const tinygltf::Material& in, const std::string& where, Textu
   out.normal_scale = finite(in.normalTexture.scale, where, "normalTexture.scale");
   out.emissive_texture =
       textures.add(texture_info(in.emissiveTexture), true, where + ": emissiveTexture");
-  const tinygltf::Value* transmission = extension(in, "KHR_materials_transmission", where);
-  if (transmission && transmission->Has("transmissionTexture")) {
-    const std::string at = where + ": transmissionTexture";
-    out.transmission_texture =
-        textures.add(texture_info(transmission->Get("transmissionTexture"), at), false, at);
+  out.transmission_texture = texture(extension(in, "KHR_materials_transmission", where),
+                                     "transmissionTexture", false, textures, where);
+  // The volume's thickness texture is checked, not read: a path tracer has the real geometry.
+  const tinygltf::Value* volume = extension(in, "KHR_materials_volume", where);
+  if (volume && volume->Has("thicknessTexture")) {
+    const std::string at = where + ": thicknessTexture";
+    textures.check(texture_info(volume->Get("thicknessTexture"), at), at);
   }
 }
 
@@ -136,6 +253,14 @@ Material convert_material(const tinygltf::Model& model, int index, TextureTable&
   out.name = in.name;
   read_factors(in, where, out);
   read_textures(in, where, textures, out);
+  read_specular(in, where, textures, out);
+  read_clearcoat(in, where, textures, out);
+  read_sheen(in, where, textures, out);
+  read_anisotropy(in, where, textures, out);
+  read_iridescence(in, where, textures, out);
+  out.dispersion = number_in(extension(in, "KHR_materials_dispersion", where),
+                             "KHR_materials_dispersion", "dispersion", 0.0f, 0.0, INFINITY, where);
+  read_diffuse_transmission(in, where, textures, out);
   return out;
 }
 

@@ -16,9 +16,10 @@ namespace wp::gltf {
 // Scene::positions.
 struct VertexNeeds {
   bool uv1 = false;       // keep TEXCOORD_1 (some texture reads it); (0, 0) where absent
-  bool tangents = false;  // keep tangents (some material has a normal texture)
-  // The TEXCOORD set this primitive's normal texture reads (0 without one): when tangents are
-  // kept and the primitive has no TANGENT, they are generated from that set.
+  bool tangents = false;  // keep tangents (some material needs a tangent frame: gltf_loader.cpp)
+  // The TEXCOORD set this primitive's normal texture reads (else its clearcoat normal or
+  // anisotropy texture; 0 without any): when tangents are kept and the primitive has no TANGENT,
+  // they are generated from that set.
   int tangent_uv = 0;
 };
 

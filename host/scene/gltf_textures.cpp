@@ -164,28 +164,28 @@ void texture_transform(const tinygltf::Value* transform, const std::string& wher
 TextureTable::TextureTable(const tinygltf::Model& model, Scene& scene)
     : model_(model), scene_(scene), image_slot_(model.images.size(), -1) {}
 
-void TextureTable::warn(const std::string& message) {
+void TextureTable::warn(const std::string& message) const {
   scene_.warnings.push_back(scene_.source + ": " + message);
 }
 
-int TextureTable::add(const TextureInfo& info, bool srgb, const std::string& where) {
-  if (info.index < 0) return -1;
+bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::string& where,
+                            bool warn_unusable, TextureRef& ref) const {
   if (static_cast<std::size_t>(info.index) >= model_.textures.size())
     throw Error(where + ": texture " + std::to_string(info.index) + " does not exist");
   const tinygltf::Texture& texture = model_.textures[static_cast<std::size_t>(info.index)];
   const std::string tex_where = where + ": texture " + std::to_string(info.index);
-  TextureRef ref;
   int texcoord = info.texcoord;
   texture_transform(info.transform, where, ref, texcoord);
   if (texcoord < 0) throw Error(where + ": texCoord " + std::to_string(texcoord) + " is negative");
   if (texcoord > 1) {
-    warn(where + ": TEXCOORD_" + std::to_string(texcoord) +
-         " is not supported (only 0 and 1); texture ignored");
-    return -1;
+    if (warn_unusable)
+      warn(where + ": TEXCOORD_" + std::to_string(texcoord) +
+           " is not supported (only 0 and 1); texture ignored");
+    return false;
   }
   if (texture.source < 0) {  // e.g. only an extension's source (KTX2, WebP)
-    warn(tex_where + " has no PNG or JPEG source; ignored");
-    return -1;
+    if (warn_unusable) warn(tex_where + " has no PNG or JPEG source; ignored");
+    return false;
   }
   if (static_cast<std::size_t>(texture.source) >= model_.images.size())
     throw Error(tex_where + ": image " + std::to_string(texture.source) + " does not exist");
@@ -200,7 +200,20 @@ int TextureTable::add(const TextureInfo& info, bool srgb, const std::string& whe
   }
   ref.srgb = srgb;
   ref.texcoord = texcoord;
-  ref.image = image(texture.source);
+  ref.image = texture.source;
+  return true;
+}
+
+void TextureTable::check(const TextureInfo& info, const std::string& where) const {
+  TextureRef ref;
+  if (info.index >= 0) describe(info, false, where, false, ref);
+}
+
+int TextureTable::add(const TextureInfo& info, bool srgb, const std::string& where) {
+  if (info.index < 0) return -1;
+  TextureRef ref;
+  if (!describe(info, srgb, where, true, ref)) return -1;
+  ref.image = image(ref.image);
   for (std::size_t i = 0; i < scene_.textures.size(); ++i)
     if (same_use(scene_.textures[i], ref)) return static_cast<int>(i);
   scene_.textures.push_back(ref);

@@ -43,9 +43,18 @@ class TextureTable {
   // cannot be read or decoded.
   int add(const TextureInfo& info, bool srgb, const std::string& where);
 
+  // The checks of add() for a texture wavepath reads nothing from (e.g. KHR_materials_volume's
+  // thicknessTexture): the texture, its sampler and image index and its transform must be valid;
+  // nothing is decoded, added or warned about.
+  void check(const TextureInfo& info, const std::string& where) const;
+
  private:
+  // add()'s TextureRef for `info` with `image` still the glTF image index, or false when the
+  // texture cannot be used (a warning says why when `warn_unusable`).
+  bool describe(const TextureInfo& info, bool srgb, const std::string& where, bool warn_unusable,
+                TextureRef& ref) const;
   int image(int index);
-  void warn(const std::string& message);
+  void warn(const std::string& message) const;
 
   const tinygltf::Model& model_;
   Scene& scene_;

@@ -70,6 +70,41 @@ struct Material {
   int normal_texture = -1;
   int emissive_texture = -1;
   int transmission_texture = -1;  // R: transmission
+  // KHR_materials_specular: colour on the dielectric F0 (clamped to 1), strength on F0 and F90.
+  glm::vec3 specular_color{1.0f};
+  int specular_texture = -1;        // A: specular (x specular)
+  int specular_color_texture = -1;  // RGB (sRGB): specular colour
+  // KHR_materials_clearcoat: a GGX dielectric coat (ior 1.5) over everything.
+  float clearcoat = 0.0f;
+  float clearcoat_roughness = 0.0f;
+  float clearcoat_normal_scale = 1.0f;
+  int clearcoat_texture = -1;            // R
+  int clearcoat_roughness_texture = -1;  // G
+  int clearcoat_normal_texture = -1;     // tangent-space normal of the coat
+  // KHR_materials_sheen: Charlie sheen over the base.
+  glm::vec3 sheen_color{0.0f};
+  float sheen_roughness = 0.0f;
+  int sheen_color_texture = -1;      // RGB (sRGB)
+  int sheen_roughness_texture = -1;  // A
+  // KHR_materials_anisotropy: strength in [0, 1], rotation (radians) of the direction from the
+  // tangent toward the bitangent.
+  float anisotropy_strength = 0.0f;
+  float anisotropy_rotation = 0.0f;
+  int anisotropy_texture = -1;  // RG: direction (x 2 - 1), B: strength
+  // KHR_materials_iridescence: thin-film interference on the specular lobes.
+  float iridescence = 0.0f;
+  float iridescence_ior = 1.3f;
+  float iridescence_thickness_min = 100.0f;  // nanometres
+  float iridescence_thickness_max = 400.0f;
+  int iridescence_texture = -1;            // R
+  int iridescence_thickness_texture = -1;  // G: mix of minimum and maximum
+  // KHR_materials_dispersion: 20 / Abbe number (0: none); used with KHR_materials_volume.
+  float dispersion = 0.0f;
+  // KHR_materials_diffuse_transmission: a Lambertian transmission lobe.
+  float diffuse_transmission = 0.0f;
+  glm::vec3 diffuse_transmission_color{1.0f};
+  int diffuse_transmission_texture = -1;        // A
+  int diffuse_transmission_color_texture = -1;  // RGB (sRGB)
 };
 
 enum class LightType : std::uint8_t { kPoint, kSpot, kDirectional };
@@ -103,8 +138,14 @@ struct Scene {
   std::string source;  // file the scene came from
   // FNV-1a 64 (fnv1a.h) of the bytes the scene was loaded from: the glTF or GLB file, then the
   // external buffers and images it names, in file order. Part of the render key (render.h): it
-  // tells films of different scenes apart. 0 for scenes not loaded from a file.
+  // tells films of different scenes apart. 0 for scenes not loaded from a file. A selected
+  // material variant (LoadOptions::variant) is hashed in after them: two variants of one file
+  // are two scenes.
   std::uint64_t digest = 0;
+  // KHR_materials_variants: the file's variant names, in file order, and the one selected
+  // ("": none, the file's own materials).
+  std::vector<std::string> variants;
+  std::string variant;
 
   // Vertices (world space). normals are unit; uv0 is TEXCOORD_0 or (0,0); color0 is COLOR_0 as
   // linear RGBA or (1,1,1,1).

@@ -36,7 +36,12 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
   } else
 #endif
   {
+#if WP_FEATURE_DISPERSION
+    path_set_flags(paths, slot,
+                   (bs.delta ? WP_PATH_DELTA : 0u) | (bs.channel << WP_PATH_CHANNEL_SHIFT));
+#else
     path_set_flags(paths, slot, bs.delta ? WP_PATH_DELTA : 0u);
+#endif
     path_set_pane_distance(paths, slot, 0.0f);
   }
   path_store_throughput(paths, slot, next, pdf);

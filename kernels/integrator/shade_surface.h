@@ -56,6 +56,9 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   const uint4 tv = scene->tri_vertices[tri];
   bool front;
   *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, &front);
+#if WP_FEATURE_DISPERSION
+  s->channel = (path_flags(paths, slot) & WP_PATH_CHANNEL_MASK) >> WP_PATH_CHANNEL_SHIFT;
+#endif
 #if WP_AOV
   if (path_bounce(paths, slot) == 0u) /* from the camera, panes passed on the way included */
     path_set_aov_depth(paths, slot, t + path_pane_distance(paths, slot));

@@ -51,7 +51,7 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
     if (layer == WP_SHADOW_MAX_LAYERS || !bsdf_has_delta(&s) || !bsdf_transmits(&s) ||
         bsdf_volume(&s))
       return; /* an occluder */
-    transmit *= microfacet_weights(&s, fabs(dot(s.ns, d)), relative_ior(&s)).transmit;
+    transmit *= bsdf_pane_transmittance(&s, d);
     if (!(max3(transmit) > 0.0f)) return;
     origin = offset_origin(s.p, -s.ng, s.p_scale); /* s.ng faces the incoming ray */
     if (finite) tmax = dot(target - origin, d);

@@ -40,7 +40,9 @@
 #define WP_CAMERA_ORTHOGRAPHIC 1u
 
 /* Path flags (path_flags in the path state). */
-#define WP_PATH_DELTA 1u /* the last scattering event was a delta (specular) lobe */
+#define WP_PATH_DELTA 1u         /* the last scattering event was a delta (specular) lobe */
+#define WP_PATH_CHANNEL_SHIFT 1u /* bits 1-2: the colour channel a dispersive refraction chose */
+#define WP_PATH_CHANNEL_MASK 6u  /* (1 R, 2 G, 3 B; 0: all three), kernels/bsdf.h */
 
 /* Queues: index arrays of path slots with an atomic counter each (see kernels/queues.h). */
 #define WP_QUEUE_RAY_A 0u /* rays to trace; A and B swap roles every bounce */
@@ -58,14 +60,30 @@ WP_DEV_BEGIN
 
 typedef struct Material {
   float4 base_color; /* linear RGB factor; a: alpha factor */
-  float4 emission; /* radiance factor (rgb): emissiveFactor x emissive strength; w: alpha cutoff */
-  float4 params;   /* x: metallic, y: roughness, z: ior, w: transmission */
-  float4 volume;   /* rgb: attenuation colour; w: attenuation distance (INFINITY: no absorption) */
-  float4 extra;    /* x: normal texture scale, y: thickness factor; z, w: unused */
-  uint4 flags;     /* x: WP_MAT_* flags; y, z, w: unused */
-  int4 textures0;  /* TextureRef indices (-1: none): x base colour, y metallic-roughness,
-                      z normal, w emissive */
-  int4 textures1;  /* x: transmission; y, z, w: -1 (reserved) */
+  float4 emission;  /* radiance factor (rgb): emissiveFactor x emissive strength; w: alpha cutoff */
+  float4 params;    /* x: metallic, y: roughness, z: ior, w: transmission */
+  float4 volume;    /* rgb: attenuation colour; w: attenuation distance (INFINITY: no absorption) */
+  float4 extra;     /* x: normal texture scale, y: thickness factor, z: unused, w: dispersion
+                       (KHR_materials_dispersion, 20 / Abbe number; 0: none) */
+  uint4 flags;      /* x: WP_MAT_* flags; y, z, w: unused */
+  int4 textures0;   /* TextureRef indices (-1: none): x base colour, y metallic-roughness,
+                       z normal, w emissive */
+  int4 textures1;   /* x: transmission (R), y: specular (A), z: specular colour (RGB),
+                       w: clearcoat (R) */
+  int4 textures2;   /* x: clearcoat roughness (G), y: clearcoat normal, z: sheen colour (RGB),
+                       w: sheen roughness (A) */
+  int4 textures3;   /* x: anisotropy (RG direction, B strength), y: iridescence (R),
+                       z: iridescence thickness (G), w: diffuse transmission (A) */
+  int4 textures4;   /* x: diffuse transmission colour (RGB); y, z, w: -1 (reserved) */
+  float4 specular;  /* KHR_materials_specular: rgb specularColorFactor, w specularFactor */
+  float4 clearcoat; /* KHR_materials_clearcoat: x factor, y roughness, z normal texture scale;
+                       w: unused */
+  float4 sheen;     /* KHR_materials_sheen: rgb sheenColorFactor, w sheenRoughnessFactor */
+  float4 anisotropy;  /* KHR_materials_anisotropy: x strength, y cos, z sin of the rotation;
+                         w: unused */
+  float4 iridescence; /* KHR_materials_iridescence: x factor, y ior, z thickness minimum,
+                         w thickness maximum (nanometres) */
+  float4 diffuse_transmission; /* KHR_materials_diffuse_transmission: rgb colour, w factor */
 } Material;
 
 /* A material's use of a texture: glTF textureInfo + sampler + KHR_texture_transform. */

@@ -1,6 +1,8 @@
 // glTF loader, gltf_loader.cpp: the file (.gltf, .glb), the scene and its node graph, extensions,
 // the framing camera, malformed files (wp::Error naming the file and the cause, never a crash).
 // Shared fixture: tests/gltf/gltf_files.h.
+#include <set>
+
 #include "tests/gltf/gltf_files.h"
 
 namespace {
@@ -31,13 +33,12 @@ TEST(GltfLoader, DefaultScene) {
 // not be).
 TEST(GltfLoader, ExtensionWarnings) {
   Gltf g = one_triangle("");
-  g.top =
-      R"("extensionsUsed":["KHR_materials_sheen","KHR_materials_volume","KHR_texture_transform",)"
-      R"("KHR_materials_unlit"],"textures":[{"source":0}],)"
-      R"("images":[{"uri":"data:image/png;base64,AAAA"}])";
+  g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing","KHR_materials_volume",)"
+          R"("KHR_texture_transform","KHR_materials_unlit","KHR_materials_sheen"],)"
+          R"("textures":[{"source":0}],"images":[{"uri":"data:image/png;base64,AAAA"}])";
   const wp::Scene s = wp::load_gltf(g.write("warn.gltf"));
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("KHR_materials_sheen"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("EXT_mesh_gpu_instancing"), std::string::npos) << s.warnings[0];
   EXPECT_TRUE(s.images.empty());
 }
 
@@ -203,6 +204,123 @@ TEST(GltfLoader, TruncatedAndCorruptedGlbNeverCrash) {
     }
   }
   EXPECT_GT(loaded, 0);  // some mutations are harmless (e.g. inside a name)
+}
+
+// Files that require any of the supported material extensions load, without warnings.
+TEST(GltfLoader, RequiredMaterialExtensionsLoad) {
+  const std::string names =
+      R"("KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen",)"
+      R"("KHR_materials_anisotropy","KHR_materials_iridescence","KHR_materials_dispersion",)"
+      R"("KHR_materials_diffuse_transmission","KHR_materials_variants","KHR_materials_volume",)"
+      R"("KHR_materials_transmission","KHR_materials_ior","KHR_materials_emissive_strength")";
+  Gltf g = one_triangle("");
+  g.top = "\"extensionsUsed\":[" + names + "],\"extensionsRequired\":[" + names + "]";
+  const wp::Scene s = wp::load_gltf(g.write("required.gltf"));
+  check_invariants(s);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+}
+
+// KHR_materials_variants. Variants red, green, blue; materials m0, m1, m2. Mesh 0's primitives:
+// A (m0; red -> m1, green and blue -> m2), B (no material; blue -> m1), C (m0, no mappings).
+Gltf variants_file() {
+  Gltf g;
+  const int pos = g.vec3s({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  const std::string a =
+      R"({"attributes":{"POSITION":0},"material":0,"extensions":{"KHR_materials_variants":)"
+      R"({"mappings":[{"material":1,"variants":[0]},{"material":2,"variants":[1,2]}]}}})";
+  const std::string b = R"({"attributes":{"POSITION":0},"extensions":{"KHR_materials_variants":)"
+                        R"({"mappings":[{"material":1,"variants":[2],"name":"blue B"}]}}})";
+  g.mesh({a, b, prim({{"POSITION", pos}}, -1, -1, 0)});
+  g.node("\"mesh\":0", true);
+  g.materials = {R"({"name":"m0"})", R"({"name":"m1"})", R"({"name":"m2"})"};
+  g.top = R"("extensionsUsed":["KHR_materials_variants"],"extensions":{)"
+          R"("KHR_materials_variants":{"variants":[{"name":"red"},{"name":"green"},)"
+          R"({"name":"blue"}]}})";
+  return g;
+}
+
+// Each variant gives each primitive its mapped material, or its own where it has no mapping for
+// the variant; no variant gives the file's own materials. Variants are different scenes to the
+// render key: the digest differs from variant to variant and from the plain file.
+TEST(GltfLoader, MaterialVariantsSelectMaterials) {
+  const std::string path = variants_file().write("variants.gltf");
+  const wp::Scene plain = wp::load_gltf(path);
+  check_invariants(plain);
+  EXPECT_TRUE(plain.warnings.empty()) << plain.warnings.front();
+  EXPECT_EQ(plain.variants, (std::vector<std::string>{"red", "green", "blue"}));
+  EXPECT_EQ(plain.variant, "");
+  ASSERT_EQ(plain.materials.size(), 4u);  // m0, m1, m2 and the default for B
+  EXPECT_EQ(plain.triangle_material, (std::vector<std::uint32_t>{0, 3, 0}));
+  EXPECT_EQ(wp::load_gltf(path, {""}).digest, plain.digest);
+  std::set<std::uint64_t> digests = {plain.digest};
+  for (const auto& [variant, materials] :
+       std::vector<std::pair<std::string, std::vector<std::uint32_t>>>{
+           {"red", {1, 3, 0}}, {"green", {2, 3, 0}}, {"blue", {2, 1, 0}}}) {
+    SCOPED_TRACE(variant);
+    const wp::Scene s = wp::load_gltf(path, {variant});
+    check_invariants(s);
+    EXPECT_EQ(s.variant, variant);
+    EXPECT_EQ(s.variants, plain.variants);
+    EXPECT_EQ(s.triangle_material, materials);
+    EXPECT_EQ(s.materials.size(), variant == "blue" ? 3u : 4u);  // the default: B's own
+    EXPECT_TRUE(digests.insert(s.digest).second) << "digest shared with another variant";
+    EXPECT_EQ(wp::load_gltf(path, {variant}).digest, s.digest);  // and stable
+  }
+}
+
+// The error of load_gltf(path, {variant}), which must be one line naming the file.
+std::string variant_error(const std::string& path, const std::string& variant) {
+  try {
+    wp::load_gltf(path, {variant});
+  } catch (const wp::Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    return what.substr(path.size() + 2);
+  }
+  ADD_FAILURE() << "variant '" << variant << "' of " << path << " loaded";
+  return "";
+}
+
+TEST(GltfLoader, UnknownMaterialVariantIsAnError) {
+  const std::string path = variants_file().write("variants.gltf");
+  EXPECT_EQ(variant_error(path, "purple"),
+            "no material variant 'purple': the file's variants are 'red', 'green', 'blue'");
+  EXPECT_EQ(variant_error(path, "Red"),  // names are matched exactly
+            "no material variant 'Red': the file's variants are 'red', 'green', 'blue'");
+  EXPECT_EQ(variant_error(one_triangle("").write("no_variants.gltf"), "red"),
+            "no material variant 'red': the file has no variants (KHR_materials_variants)");
+}
+
+// Malformed variants and mappings are errors, whether or not a variant is selected.
+TEST(GltfLoader, MalformedMaterialVariantsAreErrors) {
+  const std::string kMesh = "mesh 0 primitive 0: KHR_materials_variants: ";
+  for (const auto& [mappings, cause] : std::vector<std::pair<std::string, std::string>>{
+           {R"([{"material":7,"variants":[0]}])", "mapping 0: material 7 does not exist"},
+           {R"([{"material":1,"variants":[3]}])",
+            "mapping 0: variant 3 does not exist (the file has 3 variants)"},
+           {R"([{"material":1,"variants":[0]},{"material":2,"variants":[2,0]}])",
+            "mapping 1: variant 0 is mapped twice"},
+           {R"([{"variants":[0]}])", "mapping 0: no material index"},
+           {R"([{"material":1}])", "mapping 0: variants is not an array"},
+           {R"([{"material":1,"variants":["red"]}])",
+            "mapping 0: a variant index is not an integer"},
+           {R"({"material":1})", "mappings is not an array"},
+       }) {
+    SCOPED_TRACE(mappings);
+    Gltf g = variants_file();
+    g.meshes = {R"({"primitives":[{"attributes":{"POSITION":0},"extensions":{)"
+                R"("KHR_materials_variants":{"mappings":)" +
+                mappings + "}}}]}"};
+    const std::string path = g.write("bad_mappings.gltf");
+    expect_error(path, kMesh + cause);
+    EXPECT_NE(variant_error(path, "red").find(cause), std::string::npos);
+  }
+  Gltf g = variants_file();
+  g.top = R"("extensions":{"KHR_materials_variants":{"variants":[{"name":"red"},{"name":5}]}})";
+  expect_error(g.write("bad_variants.gltf"), "KHR_materials_variants: variant 1 has no name");
+  g.top = R"("extensions":{"KHR_materials_variants":{"variants":{}}})";
+  expect_error(g.write("bad_variants.gltf"), "KHR_materials_variants: variants is not an array");
 }
 
 }  // namespace

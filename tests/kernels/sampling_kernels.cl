@@ -10,6 +10,12 @@
  *                params = (metallic, roughness, ior, transmission), flags = Surface flags. The
  *                surface's normal is tilted_normal(), not an axis, so the BSDF's own frame is
  *                exercised; directions are reported in the frame make_basis(tilted_normal()).
+ *                The layered extensions (each set only where the program has its feature):
+ *                coat = (clearcoat, clearcoat roughness, tilt of the coat normal from ns and its
+ *                azimuth from wo's, radians), sheen = (sheen colour, sheen roughness),
+ *                specular = (specular colour, specular factor), aniso = (strength, rotation of
+ *                aniso_t from wo's azimuth in radians, -, -), irid = (iridescence factor, film
+ *                ior, film thickness in nm, -), dtrans = (diffuse transmission colour, factor).
  *   ST_TRIANGLE  sample_triangle (triangle 0 of the small scene in the buffers, light 0 with pmf
  *                1) / triangle_light_pdf times "the ray hits the emitting side"; a.xyz = the
  *                shading point. Frame: world.
@@ -37,6 +43,7 @@
 typedef struct Config {
   uint routine, frame, flags;
   float4 a, color, params;
+  float4 coat, sheen, specular, aniso, irid, dtrans; /* ST_BSDF's extensions */
 } Config;
 
 inline float3 tilted_normal(void) {
@@ -63,6 +70,42 @@ inline Surface config_surface(const Config* c) {
   s.ior = c->params.z;
   s.transmission = c->params.w;
   s.flags = c->flags;
+  /* Azimuths are measured in the frame make_basis(ns), where wo has azimuth 0. */
+  float3 t, b;
+  make_basis(s.ns, &t, &b);
+  (void)t, (void)b;
+#if WP_FEATURE_SPECULAR
+  s.specular_color = c->specular.xyz;
+#endif
+#if WP_FEATURE_GLOSSY
+  s.specular = c->specular.w;
+#endif
+#if WP_FEATURE_CLEARCOAT
+  s.clearcoat = c->coat.x;
+  s.clearcoat_roughness = c->coat.y;
+  s.nc =
+      normalize(cos(c->coat.z) * s.ns + sin(c->coat.z) * (cos(c->coat.w) * t + sin(c->coat.w) * b));
+#endif
+#if WP_FEATURE_SHEEN
+  s.sheen_color = c->sheen.xyz;
+  s.sheen_roughness = c->sheen.w;
+#endif
+#if WP_FEATURE_ANISOTROPY
+  s.anisotropy = c->aniso.x;
+  s.aniso_t = normalize(cos(c->aniso.y) * t + sin(c->aniso.y) * b);
+#endif
+#if WP_FEATURE_IRIDESCENCE
+  s.iridescence = c->irid.x;
+  s.iridescence_ior = c->irid.y;
+  s.iridescence_thickness = c->irid.z;
+#endif
+#if WP_FEATURE_DIFFUSE_TRANSMISSION
+  s.dt_color = c->dtrans.xyz;
+  s.diffuse_transmission = c->dtrans.w;
+#endif
+#if WP_FEATURE_DISPERSION
+  s.dispersion = 0.0f; /* not implemented yet */
+#endif
   return s;
 }
 
@@ -132,13 +175,35 @@ inline float rel_error3(float3 x, float3 ref) {
 /* The exact direction of a delta sample wi of surface s seen from wo: the mirror direction above
  * the surface; below it, straight through (thin-walled) or refracted with eta = n_from / n_to,
  * where a WP_SURF_VOLUME surface is entered from the front and left from the back. */
-inline float3 delta_direction(const Surface* s, float3 wo, float3 wi) {
+inline float3 base_delta_direction(const Surface* s, float3 wo, float3 wi) {
   const float cos_o = dot(wo, s->ns);
   if (dot(wi, s->ns) >= 0.0f) return 2.0f * cos_o * s->ns - wo;
   if (!(s->flags & WP_SURF_VOLUME)) return -wo;
   const float eta = (s->flags & WP_SURF_FRONT) ? 1.0f / s->ior : s->ior;
   const float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
   return -eta * wo + (eta * cos_o - sqrt(fmax(0.0f, 1.0f - sin2_t))) * s->ns;
+}
+
+/* Whether the smooth coat's delta reflection (mirror about nc) is a lobe of s. */
+inline bool coat_delta(const Surface* s) {
+#if WP_FEATURE_CLEARCOAT
+  return s->clearcoat > 0.0f && s->clearcoat_roughness * s->clearcoat_roughness < WP_DELTA_ALPHA;
+#else
+  (void)s;
+  return false;
+#endif
+}
+
+/* Distance of delta sample wi from the nearest exact direction of s's delta lobes: the base's
+ * (base_delta_direction) where the base is smooth, the mirror about the coat normal where the coat
+ * is; 2 (as far as directions go) where s has no delta lobe. */
+inline float delta_distance(const Surface* s, float3 wo, float3 wi) {
+  float d = 2.0f;
+  if (bsdf_has_delta(s)) d = length(wi - base_delta_direction(s, wo, wi));
+#if WP_FEATURE_CLEARCOAT
+  if (coat_delta(s)) d = fmin(d, length(wi - (2.0f * dot(wo, s->nc) * s->nc - wo)));
+#endif
+  return d;
 }
 
 /* One sample of an ST_BSDF configuration: dir = (local wi, kind); check = (pdf error against
@@ -155,7 +220,14 @@ inline void draw_bsdf(const Config* c, float u_lobe, float2 u, float4* dir, floa
     *dir = (float4)(l, SK_INVALID);
   } else if (bs.delta) {
     *dir = (float4)(l, SK_DELTA);
-    check->z = length(bs.wi - delta_direction(&s, wo, bs.wi));
+    check->z = delta_distance(&s, wo, bs.wi);
+    /* No density to compare with: the weight (reflectance / selection probability) must at least
+     * be a finite non-negative number. */
+    const float3 w = bs.weight;
+    check->y =
+        isfinite(w.x) && isfinite(w.y) && isfinite(w.z) && w.x >= 0.0f && w.y >= 0.0f && w.z >= 0.0f
+            ? 0.0f
+            : 1.0f;
   } else {
     *dir = (float4)(l, SK_SMOOTH);
     const BsdfEval e = bsdf_eval(&s, wo, bs.wi);
@@ -188,15 +260,17 @@ inline void draw_other(const Config* c, const SceneView* scene, float2 u, float4
   check->w = pdf;
 }
 
-#define WP_CONFIG_PARAMS                                                       \
-  uint routine, uint frame, uint flags, float4 a, float4 color, float4 params, \
-      __global const float4 *positions, __global const uint4 *tri_vertices,    \
-      __global const Material *materials, __global const uint *tri_light,      \
+#define WP_CONFIG_PARAMS                                                                    \
+  uint routine, uint frame, uint flags, float4 a, float4 color, float4 params, float4 coat, \
+      float4 sheen, float4 specular, float4 aniso, float4 irid, float4 dtrans,              \
+      __global const float4 *positions, __global const uint4 *tri_vertices,                 \
+      __global const Material *materials, __global const uint *tri_light,                   \
       __global const LightAlias *light_alias
 
-#define WP_CONFIG_BIND                                          \
-  const Config cfg = {routine, frame, flags, a, color, params}; \
-  const SceneView scene =                                       \
+#define WP_CONFIG_BIND                                                 \
+  const Config cfg = {routine, frame, flags,    a,     color, params,  \
+                      coat,    sheen, specular, aniso, irid,  dtrans}; \
+  const SceneView scene =                                              \
       test_scene(positions, tri_vertices, materials, tri_light, light_alias, (const SceneDesc*)0)
 
 /* From: a configuration, a seed. To: `count` samples, dir = (local direction, SK_* kind) and
@@ -263,15 +337,30 @@ __kernel void integrate_pdf(WP_CONFIG_PARAMS, __global const float4* rects, uint
   out[i] = (float2)(fine, error);
 }
 
-/* The lobe selection probabilities (specular, transmission, diffuse) of an ST_BSDF configuration
- * at its wo: for a smooth surface, the delta fractions to expect above and below it. */
+/* The lobe selection probabilities of an ST_BSDF configuration at its wo, and which lobes are
+ * delta lobes: the delta fractions to expect above and below the surface. out = (specular,
+ * transmission, diffuse, diffuse transmission, sheen, coat, 1 if the base's specular lobes are
+ * delta lobes, 1 if the coat is a delta lobe whose mirror direction is valid (above ns and ng),
+ * bsdf_only_delta). */
 __kernel void lobe_selection(WP_CONFIG_PARAMS, __global float* out) {
   if (get_global_id(0) != 0) return;
   WP_CONFIG_BIND;
   (void)scene;
   const Surface s = config_surface(&cfg);
-  const Lobes l = bsdf_lobes(&s, cfg.a.z, relative_ior(&s));
+  float3 t, b;
+  make_basis(s.ns, &t, &b);
+  const float3 wo = to_world(cfg.a.xyz, t, b, s.ns);
+  const Lobes l = bsdf_lobes(&s, wo, dot(wo, s.ns), relative_ior(&s));
   out[0] = l.spec, out[1] = l.trans, out[2] = l.diff;
+  out[3] = l.dtrans, out[4] = l.sheen, out[5] = l.coat;
+  out[6] = bsdf_has_delta(&s) ? 1.0f : 0.0f;
+  bool coat_mirror = false;
+#if WP_FEATURE_CLEARCOAT
+  const float3 m = 2.0f * dot(wo, s.nc) * s.nc - wo;
+  coat_mirror = coat_delta(&s) && dot(m, s.ns) > 0.0f && dot(m, s.ng) > 0.0f;
+#endif
+  out[7] = coat_mirror ? 1.0f : 0.0f;
+  out[8] = bsdf_only_delta(&s) ? 1.0f : 0.0f;
 }
 
 /* From: an alias table of `light_count` entries. To: `count` picks (index, reported pmf, what is

@@ -91,16 +91,19 @@ inline const float4 kPoison{as_float(kPoisonBits), as_float(kPoisonBits), as_flo
                             as_float(kPoisonBits)};
 
 // Every path-state field (kernels/shared/path_state.def) by name; the AOV fields take no memory
-// without AOVs, so they are left out.
+// without AOVs, nor the material extensions' fields without their features (the stage scenes use
+// none), so they are left out.
 struct Field {
   const char* name;
   wp::dev::uint wp::dev::PathLayout::*offset;
 };
 #define WP_PATH_FIELD(type, name, description) Field{#name, &wp::dev::PathLayout::name},
 #define WP_PATH_AOV_FIELD(type, name, description)
+#define WP_PATH_OPT_FIELD(features, type, name, description)
 const Field kFields[] = {
 #include "kernels/shared/path_state.def"
 };
+#undef WP_PATH_OPT_FIELD
 #undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
 
