@@ -139,9 +139,10 @@ def venv_python(venv):
     return os.path.join(venv, "bin", "python")
 
 
-def ensure_venv(a):
+def ensure_venv(a, script=None):
     """Creates --venv with the packages the renderers need (pip install is a no-op when present)
-    and re-executes this script inside it, unless already there."""
+    and re-executes this script (or `script`, another tool built on this one) inside it, unless
+    already there."""
     if os.environ.get(VENV_MARK) == "1":
         return
     py = venv_python(a.venv)
@@ -158,7 +159,7 @@ def ensure_venv(a):
                  "wheel was built for, 3.11 for bpy 5.0: see --python; --renderers can leave a "
                  "peer out)" % (" ".join(packages), a.venv))
     os.environ[VENV_MARK] = "1"
-    os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:])
+    os.execv(py, [py, os.path.abspath(script or __file__)] + sys.argv[1:])
 
 
 def find_libllvm():
@@ -358,11 +359,19 @@ def _cycles_backface_transparent(m):
 def worker_cycles_gltf(bpy, job, scene):
     """--pbr: the glTF through Blender's own importer (io_scene_gltf2), Principled BSDFs set to
     single-scatter GGX, the environment map as the world (see the --help text)."""
-    import math
     sc = _cycles_settings(bpy, job)
     sc.cycles.use_light_tree = bool(scene.get("light_tree"))  # --cycles-light-tree
     bpy.ops.import_scene.gltf(filepath=scene["gltf"])
     sc = bpy.context.scene
+    _cycles_gltf_materials(bpy)
+    _cycles_world(bpy, sc, scene)
+    _cycles_camera(bpy, sc, scene["camera"], lambda v: (v[0], -v[2], v[1]))
+    _cycles_render(bpy, sc, job)
+
+
+def _cycles_gltf_materials(bpy):
+    """The imported materials as --pbr renders them: every Principled BSDF single-scatter GGX with
+    subsurface weight 0; back faces of backface-culled materials transparent."""
     for m in bpy.data.materials:
         if not m.use_nodes:
             continue
@@ -372,6 +381,12 @@ def worker_cycles_gltf(bpy, job, scene):
                 n.inputs["Subsurface Weight"].default_value = 0.0
         if m.use_backface_culling:  # the importer's mark of a glTF material not double-sided
             _cycles_backface_transparent(m)
+
+
+def _cycles_world(bpy, sc, scene):
+    """The world of --pbr: scene["env"] (an equirectangular map, scene["env_intensity"],
+    scene["env_rotation"]) as wavepath's --env, or the constant scene["env_color"]."""
+    import math
     world = bpy.data.worlds.new("env")
     world.use_nodes = True
     nt = world.node_tree
@@ -397,8 +412,6 @@ def worker_cycles_gltf(bpy, job, scene):
         bg.inputs["Color"].default_value = tuple(scene["env_color"]) + (1.0,)
         bg.inputs["Strength"].default_value = 1.0
     sc.world = world
-    _cycles_camera(bpy, sc, scene["camera"], lambda v: (v[0], -v[2], v[1]))
-    _cycles_render(bpy, sc, job)
 
 
 def worker_main(renderer, job_path):
@@ -680,7 +693,8 @@ def cycles_reference(a, scene_json, env):
              .encode())
     import inspect  # the Cycles worker's code, so that a change to it renders afresh
     for f in (_cycles_settings, _cycles_camera, _cycles_render, worker_cycles,
-              _cycles_backface_transparent, worker_cycles_gltf):
+              _cycles_backface_transparent, worker_cycles_gltf, _cycles_gltf_materials,
+              _cycles_world):
         h.update(inspect.getsource(f).encode())
     path = os.path.join(a.work, "reference-cycles-%d-%s.npz" % (a.ref_spp, h.hexdigest()[:16]))
     if not os.path.exists(path):
