@@ -1,7 +1,7 @@
 /* The glTF 2.0 material BSDF: metallic-roughness (specification, appendix B) with
  * KHR_materials_transmission, KHR_materials_ior and KHR_materials_volume, and the layered
- * extensions (specular, clearcoat, sheen, anisotropy, iridescence, diffuse transmission), evaluated
- * and importance-sampled.
+ * extensions (specular, clearcoat, sheen, anisotropy, iridescence, diffuse transmission) and
+ * dispersion (a path's colour channel, bsdf_sample), evaluated and importance-sampled.
  *
  * The base, per the specification and KHR_materials_specular's fresnel_mix:
  *   f_base = metallic * F_m * D V
@@ -618,6 +618,9 @@ static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, 
   r.pdf = cosine_hemisphere_pdf(cos_i);
   r.weight = s->color;
   r.valid = true;
+#if WP_FEATURE_DISPERSION
+  r.channel = s->channel;
+#endif
   return r;
 }
 

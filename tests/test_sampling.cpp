@@ -13,16 +13,22 @@
 //   the BSDF) and a BSDF weight equals f |cos| / pdf (relative 1e-5); delta samples lie on the
 //   exact direction of one of the surface's delta lobes (mirror about ns or the coat normal,
 //   refraction) and have a finite weight >= 0.
+// KHR_materials_dispersion (Dispersion*): where a path of all channels chooses one, the channels'
+// frequencies (chi-square against 1/3) and, per chosen channel, the directions against that
+// channel's BSDF (the checks above on the samples that chose it); with the channel chosen earlier,
+// the checks above; and dispersion 0 bit for bit the program without the feature.
 //
 // False alarms: a correct routine fails one configuration's chi-square with probability 1e-4 (the
-// 5-sigma checks add ~1e-6); over the 228 configurations here that is at most 2.3% (union bound)
-// for a random choice of seeds. Seeds are fixed, so a given build on a given device passes or
-// fails reproducibly; a change of the random stream (new code, another device's rounding) draws
-// anew from that 2.3%.
+// 5-sigma checks add ~1e-6); over the ~250 chi-squares here (228 configurations, 22 of
+// dispersion's) that is at most 2.5% (union bound) for a random choice of seeds. Seeds are fixed,
+// so a given build on a given device passes or fails reproducibly; a change of the random stream
+// (new code, another device's rounding) draws anew from that 2.5%.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <iomanip>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -86,6 +92,7 @@ struct Config {
   // kBsdf's layered extensions (sampling_kernels.cl, ST_BSDF); the defaults leave each out, with
   // KHR_materials_specular's default colour and factor 1. Set by the with_* functions below.
   float4 coat{}, sheen{}, specular{1, 1, 1, 1}, aniso{}, irid{}, dtrans{};
+  float4 disp{};  // KHR_materials_dispersion: (dispersion factor, the path's channel 0-3)
   std::uint32_t samples = kSamples;  // at most kSamples
   // ST_TRIANGLE: counter-clockwise seen from the origin, so its front faces the shading point;
   // the vertices lie off the bins' grid lines (a vertex on one makes a sliver that only rounding
@@ -123,6 +130,23 @@ struct Integrals {
   std::vector<double> value, error;  // per bin
 };
 
+// The counts and maxima of d from its dirs and checks.
+void tally(Draw& d) {
+  for (std::size_t i = 0; i < d.dirs.size(); ++i) {
+    const float4 v = d.dirs[i], k = d.checks[i];
+    if (v.w == 0.0f) {
+      ++d.invalid;
+      continue;
+    }
+    (v.w == 1.0f ? d.smooth : d.delta) += 1;
+    d.below += v.z < 0.0f;
+    d.delta_below += v.z < 0.0f && v.w == 2.0f;
+    d.pdf_error = std::max(d.pdf_error, static_cast<double>(k.x));
+    d.weight_error = std::max(d.weight_error, static_cast<double>(k.y));
+    d.third_error = std::max(d.third_error, static_cast<double>(k.z));
+  }
+}
+
 // The test kernels, built once per process, and the sample buffers every draw reuses.
 class Device {
  public:
@@ -136,26 +160,21 @@ class Device {
     static Device general("");
     return general;
   }
+  // The program without KHR_materials_dispersion's code (WP_FEATURE_DISPERSION 0), for the known
+  // answer that dispersion 0 is the BSDF without it.
+  static Device& without_dispersion() {
+    static Device none("-D WP_FEATURE_DISPERSION=0");
+    return none;
+  }
 
-  Draw draw(const Config& c) {
+  // `kernel`: draw_samples, or draw_channel_choice (its checks differ: sampling_kernels.cl).
+  Draw draw(const Config& c, const char* kernel = "draw_samples") {
     const std::uint32_t n = std::min(c.samples, kSamples);
-    run(c, "draw_samples", n, seed_of(c.name), n, dirs_, checks_);
+    run(c, kernel, n, seed_of(c.name), n, dirs_, checks_);
     Draw d;
     d.dirs = h_.read<float4>(dirs_, n);
     d.checks = h_.read<float4>(checks_, n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const float4 v = d.dirs[i], k = d.checks[i];
-      if (v.w == 0.0f) {
-        ++d.invalid;
-        continue;
-      }
-      (v.w == 1.0f ? d.smooth : d.delta) += 1;
-      d.below += v.z < 0.0f;
-      d.delta_below += v.z < 0.0f && v.w == 2.0f;
-      d.pdf_error = std::max(d.pdf_error, static_cast<double>(k.x));
-      d.weight_error = std::max(d.weight_error, static_cast<double>(k.y));
-      d.third_error = std::max(d.third_error, static_cast<double>(k.z));
-    }
+    tally(d);
     return d;
   }
 
@@ -192,6 +211,12 @@ class Device {
 
   wp::test::KernelHarness& harness() { return h_; }
 
+  // Runs `kernel` with c's arguments, then `rest` (bsdf_queries).
+  template <class... Rest>
+  void run_config(const Config& c, const char* kernel, std::size_t items, Rest&&... rest) {
+    run(c, kernel, items, std::forward<Rest>(rest)...);
+  }
+
  private:
   explicit Device(const std::string& options) : h_({"sampling_kernels.cl"}, options) {
     dirs_ = h_.buffer<float4>(std::size_t{kSamples});
@@ -209,9 +234,10 @@ class Device {
     const std::vector<wp::dev::uint4> tri_vertices = {{0, 1, 2, 0}};
     const std::vector<wp::dev::LightAlias> alias = {{1.0f, 0u, 1.0f, 0u}};
     h_.run(kernel, items, c.routine, c.frame, c.flags, c.a, c.color, c.params, c.coat, c.sheen,
-           c.specular, c.aniso, c.irid, c.dtrans, h_.buffer(c.triangle), h_.buffer(tri_vertices),
-           h_.buffer(std::vector<wp::dev::Material>{m}), h_.buffer(std::vector<std::uint32_t>{0u}),
-           h_.buffer(alias), std::forward<Rest>(rest)...);
+           c.specular, c.aniso, c.irid, c.dtrans, c.disp, h_.buffer(c.triangle),
+           h_.buffer(tri_vertices), h_.buffer(std::vector<wp::dev::Material>{m}),
+           h_.buffer(std::vector<std::uint32_t>{0u}), h_.buffer(alias),
+           std::forward<Rest>(rest)...);
   }
 
   wp::test::KernelHarness h_;
@@ -305,11 +331,9 @@ double pdf_rounding(const Config& c) {
   return alpha > 0.0 ? 2.4e-7 / (alpha * alpha) : 0.0;
 }
 
-// Draws configuration c and applies the checks listed at the top of the file. Returns the draw
-// for further checks by the caller.
-Draw check_config(const Config& c) {
-  SCOPED_TRACE(c.name);
-  const Draw d = Device::get(c.lambert_build).draw(c);
+// The distribution checks of draw d of configuration c (c.samples samples): the mass, the
+// chi-square, and all_valid's.
+void check_distribution(const Config& c, const Draw& d) {
   const Fit f = fit(c, d);
   const double n = c.samples, smooth = static_cast<double>(d.smooth) / n;
   // Integration error: 3x the sum of the per-bin estimates (on smooth integrands each is many
@@ -324,6 +348,18 @@ Draw check_config(const Config& c) {
   if (d.smooth > 0) {
     EXPECT_GT(f.chi2.p_value, 1e-4) << f.chi2.detail;
   }
+  std::printf("%-48s smooth %.4f delta %.4f invalid %.4f | int %.5f +- %.1e | %s\n", c.name.c_str(),
+              smooth, static_cast<double>(d.delta) / n, static_cast<double>(d.invalid) / n, f.total,
+              tol, d.smooth > 0 ? f.chi2.detail.c_str() : "no density to test");
+  std::fflush(stdout);
+}
+
+// Draws configuration c and applies the checks listed at the top of the file. Returns the draw
+// for further checks by the caller.
+Draw check_config(const Config& c) {
+  SCOPED_TRACE(c.name);
+  const Draw d = Device::get(c.lambert_build).draw(c);
+  check_distribution(c, d);
   // GGX: the eval side rebuilds h from l = reflect(v, h); where v + l is short (grazing v) that
   // loses a few bits, and D(h) of a small alpha is steep. The BSDF's sample reports bsdf_eval's
   // pdf and f at the very direction it returns, so the two sides agree to rounding (1e-5 leaves
@@ -334,10 +370,6 @@ Draw check_config(const Config& c) {
       << "weight vs f |cos| / pdf (a delta sample: a finite weight >= 0)";
   EXPECT_LE(d.third_error, c.routine == kTriangle ? 1e-4 : 1e-5)
       << (c.routine == kTriangle ? "distance vs ray hit" : "delta direction");
-  std::printf("%-48s smooth %.4f delta %.4f invalid %.4f | int %.5f +- %.1e | %s\n", c.name.c_str(),
-              smooth, static_cast<double>(d.delta) / n, static_cast<double>(d.invalid) / n, f.total,
-              tol, d.smooth > 0 ? f.chi2.detail.c_str() : "no density to test");
-  std::fflush(stdout);
   return d;
 }
 
@@ -353,17 +385,17 @@ Config bsdf_config(float metallic, float roughness, float4 color, double view_de
   return c;
 }
 
-// A BSDF configuration: check_config, then the lobe choice. A smooth surface (roughness 0; with
-// anisotropy, alpha along the anisotropy direction below WP_DELTA_ALPHA) has delta lobes for
-// specular reflection and transmission, and a smooth coat (clearcoat roughness 0) a delta
-// reflection about the coat normal, each chosen with bsdf_lobes' probabilities, so the fractions
-// of delta samples above and below the surface must match them (the coat's mirror direction is
-// lost, not a sample, where it falls below the surface); without delta lobes there are no delta
-// samples. Nothing goes below a surface that transmits neither specularly nor diffusely, nor below
-// a smooth one past the critical angle without diffuse transmission. A BSDF that bsdf_only_delta
-// says is all delta lobes (light sampling then skips it) has no sample with a density.
-void check_bsdf(const Config& c) {
-  const Draw d = check_config(c);
+// A BSDF configuration's lobe choice in its draw d of c.samples samples (check_bsdf: after
+// check_config). A smooth surface (roughness 0; with anisotropy, alpha along the anisotropy
+// direction below WP_DELTA_ALPHA) has delta lobes for specular reflection and transmission, and a
+// smooth coat (clearcoat roughness 0) a delta reflection about the coat normal, each chosen with
+// bsdf_lobes' probabilities, so the fractions of delta samples above and below the surface must
+// match them (the coat's mirror direction is lost, not a sample, where it falls below the surface);
+// without delta lobes there are no delta samples. Nothing goes below a surface that transmits
+// neither specularly nor diffusely, nor below a smooth one past the critical angle without diffuse
+// transmission. A BSDF that bsdf_only_delta says is all delta lobes (light sampling then skips it)
+// has no sample with a density.
+void check_lobe_fractions(const Config& c, const Draw& d) {
   SCOPED_TRACE(c.name);
   const Device::Lobes l = Device::get(c.lambert_build).lobes(c);
   const double n = c.samples;
@@ -389,6 +421,10 @@ void check_bsdf(const Config& c) {
   } else if (l.trans + l.dtrans > 0.01) {
     EXPECT_GT(d.below, 0u);
   }
+}
+
+void check_bsdf(const Config& c) {
+  check_lobe_fractions(c, check_config(c));
 }
 
 // The layered extensions on a bsdf_config (sampling_kernels.cl, ST_BSDF), each named in the
@@ -438,6 +474,15 @@ Config with_diffuse_transmission(Config c, float factor, float4 color) {
   std::snprintf(s, sizeof s, " dt %.1f (%.1f,%.1f,%.1f)", factor, color.x, color.y, color.z);
   c.name += s;
   c.dtrans = {color.x, color.y, color.z, factor};
+  return c;
+}
+// KHR_materials_dispersion: the dispersion factor and the path's channel (0: all three, 1 R, 2 G,
+// 3 B: a path that chose it earlier).
+Config with_dispersion(Config c, float dispersion, int channel) {
+  char s[64];
+  std::snprintf(s, sizeof s, " disp %.1f ch %d", dispersion, channel);
+  c.name += s;
+  c.disp = {dispersion, static_cast<float>(channel), 0, 0};
   return c;
 }
 Config with_samples(Config c, std::uint32_t samples) {
@@ -651,8 +696,8 @@ TEST(Sampling, Iridescence) {
   for (const Config& c : configs) check_bsdf(with_samples(c, kSweepSamples));
 }
 
-// Every extension at once (dispersion stays 0: not implemented), entering a volume, leaving it and
-// thin-walled.
+// Every extension at once (dispersion aside: see the Dispersion tests below), entering a volume,
+// leaving it and thin-walled.
 TEST(Sampling, LayeredKitchenSink) {
   for (std::uint32_t flags : {kVolume | kFront, kVolume, kFront}) {
     Config c = bsdf_config(0.3f, 0.4f, kSaturated, 40, 0.4f, flags);
@@ -663,6 +708,141 @@ TEST(Sampling, LayeredKitchenSink) {
     c = with_iridescence(c, 0.8f);
     c = with_diffuse_transmission(c, 0.5f, {0.3f, 0.8f, 0.6f, 0});
     check_bsdf(with_samples(c, kLayeredSamples));
+  }
+}
+
+// KHR_materials_dispersion, a path of all three channels at a dispersive surface (c.disp.y 0):
+// bsdf_sample chooses channel k (1 R, 2 G, 3 B) with probability 1/3 and samples channel k's BSDF,
+// the surface with the path's channel k (docs/light-transport.md "Dispersion"). Checks:
+// (a) the chosen channels' frequencies against 1/3 each: chi-square on 3 bins, p > 1e-4, and no
+//     channel outside 1-3;
+// (b) per channel k, the samples that chose it against the surface with channel k preset: the
+//     chi-square of their directions against its bsdf_eval pdf and its mass (check_distribution),
+//     and their delta fractions against its lobes (check_lobe_fractions): the distribution given
+//     the channel is channel k's BSDF's;
+// and per sample: the reported pdf is 0 (no light sample is taken there, bsdf_only_delta), the
+// weight is 3 f_k |cos| / pdf_k on channel k and 0 on the others (relative 1e-5; f_k and pdf_k
+// bsdf_eval's for channel k), and a delta sample lies on the exact direction for channel k's
+// index (its refraction computed from the documented formula, path_ior in the .cl).
+void check_channel_choice(const Config& c) {
+  SCOPED_TRACE(c.name);
+  const Draw d = Device::get(false).draw(c, "draw_channel_choice");
+  EXPECT_EQ(d.pdf_error, 0.0) << "a pdf reported where the channel is chosen";
+  EXPECT_LE(d.weight_error, 1e-5)
+      << "weight vs 3 f_k |cos| / pdf_k on channel k (a delta sample: finite, >= 0, only on k)";
+  EXPECT_LE(d.third_error, 1e-5) << "delta direction of the chosen channel's index";
+  std::vector<double> observed(3, 0.0), expected(3, c.samples / 3.0);
+  std::size_t outside = 0;
+  Draw per[3];
+  for (std::size_t i = 0; i < d.dirs.size(); ++i) {
+    const float k = d.checks[i].w;
+    if (!(k == 1.0f || k == 2.0f || k == 3.0f)) {
+      ++outside;
+      continue;
+    }
+    const auto j = static_cast<std::size_t>(k) - 1;
+    observed[j] += 1.0;
+    per[j].dirs.push_back(d.dirs[i]), per[j].checks.push_back(d.checks[i]);
+  }
+  EXPECT_EQ(outside, 0u) << "a channel outside 1-3";
+  const auto r = wp::test::chi2_test(observed, expected);
+  EXPECT_GT(r.p_value, 1e-4) << "channel frequencies vs 1/3: " << r.detail;
+  std::printf("%-48s channels R %.4f G %.4f B %.4f | %s\n", c.name.c_str(), observed[0] / c.samples,
+              observed[1] / c.samples, observed[2] / c.samples, r.detail.c_str());
+  for (int k = 1; k <= 3; ++k) {
+    Draw& dk = per[k - 1];
+    tally(dk);
+    Config ck = c;  // the same surface on a path of channel k
+    ck.disp.y = static_cast<float>(k);
+    ck.name += " | chose " + std::to_string(k);
+    ck.samples = static_cast<std::uint32_t>(dk.dirs.size());
+    if (ck.samples == 0) continue;  // (a) failed already
+    check_distribution(ck, dk);
+    check_lobe_fractions(ck, dk);
+  }
+}
+
+// Dispersive glass (ior 1.5; dispersion 20: indices R 1.4013, G 1.6667, B 1.9525, critical
+// angles 45.5, 36.9 and 30.8 degrees from inside), rough and smooth, entering and leaving, at a
+// view where the channels disagree on total internal reflection (38 degrees: R refracts, G and B
+// do not), a narrow lobe (roughness 0.1, dispersion 5) and every lobe at once (metal, diffuse and
+// transmission beside each other).
+TEST(Sampling, DispersionChannelChoice) {
+  const std::vector<Config> configs = {
+      with_dispersion(bsdf_config(0, 0.3f, kWhite, 45, 1, kVolume | kFront), 20, 0),
+      with_dispersion(bsdf_config(0, 0.3f, kWhite, 38, 1, kVolume), 20, 0),
+      with_dispersion(bsdf_config(0, 0.1f, kWhite, 30, 1, kVolume | kFront), 5, 0),
+      with_dispersion(bsdf_config(0, 0.0f, kWhite, 45, 1, kVolume | kFront), 20, 0),
+      with_dispersion(bsdf_config(0, 0.0f, kWhite, 38, 1, kVolume), 20, 0),
+      with_dispersion(bsdf_config(0.3f, 0.4f, kSaturated, 40, 0.5f, kVolume | kFront), 5, 0),
+  };
+  for (const Config& c : configs) check_channel_choice(with_samples(c, kLayeredSamples));
+}
+
+// (c) A path that chose its channel earlier (Surface.channel preset): the surface is channel k's
+// BSDF, an ordinary one, and check_bsdf holds it to bsdf_eval (pdf and weight of every sample,
+// chi-square, mass, delta fractions; delta directions refracted with channel k's index by the
+// documented formula, path_ior in the .cl).
+TEST(Sampling, DispersionChannelPreset) {
+  const std::vector<Config> configs = {
+      with_dispersion(bsdf_config(0, 0.3f, kWhite, 45, 1, kVolume | kFront), 20, 1),
+      with_dispersion(bsdf_config(0, 0.3f, kWhite, 38, 1, kVolume), 20, 3),  // B: past critical
+      with_dispersion(bsdf_config(0, 0.3f, kWhite, 38, 1, kVolume), 20, 2),  // G: past it too
+      with_dispersion(bsdf_config(0, 0.0f, kWhite, 45, 1, kVolume | kFront), 20, 3),
+      with_dispersion(bsdf_config(0, 0.0f, kWhite, 38, 1, kVolume), 20, 1),  // R: not past it
+      with_dispersion(bsdf_config(0.3f, 0.4f, kSaturated, 40, 0.5f, kVolume | kFront), 5, 2),
+  };
+  for (const Config& c : configs) check_bsdf(with_samples(c, kSweepSamples));
+}
+
+// Known answer: dispersion 0 (the feature compiled in, the factor 0) is the BSDF without
+// dispersion: every bsdf_sample (direction, weight, pdf, eta_scale, valid, delta), bsdf_eval at a
+// direction on the sphere and bsdf_only_delta are bit for bit those of the program built without
+// KHR_materials_dispersion (WP_FEATURE_DISPERSION 0), on a path of all channels and on one that
+// chose G. So is a thin-walled glass at dispersion 20 (the extension acts through a volume's
+// refraction only). Glass smooth, at the delta threshold's far side (roughness 0.05) and rough,
+// entering and leaving (past the critical angle too), every lobe at once, every extension.
+TEST(Sampling, DispersionZeroIsTheBsdfWithoutIt) {
+  std::vector<Config> configs;
+  for (std::uint32_t flags : {kVolume | kFront, kVolume})
+    for (float roughness : {0.0f, 0.05f, 0.3f})
+      for (double view : {30.0, 60.0})
+        configs.push_back(bsdf_config(0, roughness, kWhite, view, 1, flags));
+  configs.push_back(bsdf_config(0.3f, 0.4f, kSaturated, 40, 0.5f, kVolume | kFront));
+  Config sink = bsdf_config(0.3f, 0.4f, kSaturated, 40, 0.4f, kVolume | kFront);
+  sink = with_coat(sink, 0.7f, 0.2f, 15, 120);
+  sink = with_sheen(sink, {0.5f, 0.7f, 0.9f, 0}, 0.5f);
+  sink = with_specular(sink, {0.8f, 1.2f, 1.0f, 0}, 0.8f);
+  sink = with_aniso(sink, 0.6f, 60);
+  sink = with_iridescence(sink, 0.8f);
+  sink = with_diffuse_transmission(sink, 0.5f, {0.3f, 0.8f, 0.6f, 0});
+  configs.push_back(sink);
+  std::vector<Config> cases;
+  for (const Config& c : configs)
+    for (int channel : {0, 2}) cases.push_back(with_dispersion(c, 0.0f, channel));
+  for (float roughness : {0.0f, 0.3f})
+    cases.push_back(with_dispersion(bsdf_config(0, roughness, kWhite, 45, 1, kFront), 20, 0));
+  constexpr std::uint32_t n = 1u << 14;
+  Device& with = Device::get(false);
+  Device& without = Device::without_dispersion();
+  cl::Buffer out_with = with.harness().buffer<float4>(4 * std::size_t{n});
+  cl::Buffer out_without = without.harness().buffer<float4>(4 * std::size_t{n});
+  for (const Config& c : cases) {
+    SCOPED_TRACE(c.name);
+    with.run_config(c, "bsdf_queries", n, seed_of(c.name), n, out_with);
+    without.run_config(c, "bsdf_queries", n, seed_of(c.name), n, out_without);
+    const auto a = with.harness().read<float4>(out_with, 4 * std::size_t{n});
+    const auto b = without.harness().read<float4>(out_without, 4 * std::size_t{n});
+    std::size_t differ = 0, first = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (std::memcmp(&a[i], &b[i], sizeof(float4)) != 0 && differ++ == 0) first = i;
+    if (differ > 0) {
+      const float4 x = a[first], y = b[first];
+      ADD_FAILURE() << std::setprecision(9) << differ << " of " << a.size()
+                    << " float4s differ; the first, sample " << first / 4 << " part " << first % 4
+                    << " (bsdf_queries): (" << x.x << ", " << x.y << ", " << x.z << ", " << x.w
+                    << ") vs (" << y.x << ", " << y.y << ", " << y.z << ", " << y.w << ")";
+    }
   }
 }
 

@@ -33,14 +33,23 @@ inline bool finite3(float3 v) {
 typedef struct AlbedoSample {
   float3 bsdf_only, mis;
   bool bad;
+  /* The BSDF sample's own fields, for dispersion_albedo_estimates' bookkeeping: valid, pdf and
+   * the path's channel after it (BsdfSample.channel; 0 in programs without the feature). */
+  bool valid;
+  float pdf;
+  uint channel;
 } AlbedoSample;
 
 inline AlbedoSample albedo_sample(const Surface* s, float3 wo, float3 t, float3 b, uint i,
                                   uint seed) {
   const Rng r = rng_make(i, 0u, seed, 0u);
-  AlbedoSample a = {(float3)(0.0f), (float3)(0.0f), false};
+  AlbedoSample a = {(float3)(0.0f), (float3)(0.0f), false, false, 0.0f, 0u};
   const BsdfSample bs =
       bsdf_sample(s, wo, rng_get(r, WP_DIM_BSDF_LOBE), rng_get2(r, WP_DIM_BSDF_U));
+  a.valid = bs.valid, a.pdf = bs.pdf;
+#if WP_FEATURE_DISPERSION
+  a.channel = bs.channel;
+#endif
   const float p_light = 1.0f / (4.0f * WP_PI);
   if (bs.valid) {
     a.bad |= !finite3(bs.weight) || !isfinite(bs.pdf);
@@ -140,6 +149,60 @@ __kernel void layered_albedo_estimates(float4 color, float4 params, uint flags, 
   const AlbedoSample a = albedo_sample(&s, wo, t, b, i, seed);
   out[2 * i] = (float4)(a.bsdf_only, a.bad ? 1.0f : 0.0f);
   out[2 * i + 1] = (float4)(a.mis, 0.0f);
+}
+
+/* KHR_materials_dispersion (bsdf.h): as albedo_estimates for the surface with dispersion factor
+ * `dispersion` and the path's channel `channel` (Surface.channel: 0 for a path of all three
+ * channels, else the channel it chose earlier, 1 R, 2 G, 3 B). Per sample i, every channel:
+ *   out[2 i]     = (BSDF sampling alone, rgb; 1 when a value was NaN or infinite, else 0),
+ *   out[2 i + 1] = (MIS with the light sample, rgb; 1 when the channel bookkeeping of the
+ *                  documented model was broken, else 0): with channel 0 at a dispersive surface,
+ *                  the sample's channel is one of 1-3 and a valid sample's weight is 0 on the
+ *                  other channels, its pdf is reported 0, and no light sample is taken
+ *                  (bsdf_only_delta); with a channel preset, the sample keeps it. */
+__kernel void dispersion_albedo_estimates(float4 color, float4 params, uint flags, float cos_o,
+                                          float dispersion, uint channel, uint seed, uint count,
+                                          __global float4* out) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  Surface s = plain_surface(color, params, flags);
+  bool broken = false;
+#if WP_FEATURE_DISPERSION
+  s.dispersion = dispersion, s.channel = channel;
+#else
+  broken = dispersion > 0.0f; /* nothing to test in this program */
+  (void)channel;
+#endif
+  float3 t, b;
+  make_basis(s.ns, &t, &b);
+  const float sin_o = sqrt(fmax(0.0f, 1.0f - cos_o * cos_o));
+  const float3 wo = sin_o * t + cos_o * s.ns;
+  const AlbedoSample a = albedo_sample(&s, wo, t, b, i, seed);
+  const bool dispersive =
+      dispersion > 0.0f && (flags & WP_SURF_VOLUME) && params.w > 0.0f && params.x < 1.0f;
+  if (channel == 0u && dispersive) {
+    broken |= a.channel < 1u || a.channel > 3u || !bsdf_only_delta(&s);
+    if (a.valid) {
+      const float w[3] = {a.bsdf_only.x, a.bsdf_only.y, a.bsdf_only.z};
+      for (uint k = 0; k < 3u; ++k) broken |= k + 1u != a.channel && w[k] != 0.0f;
+      broken |= a.pdf != 0.0f;
+    }
+  } else {
+    broken |= a.channel != channel;
+  }
+  out[2 * i] = (float4)(a.bsdf_only, a.bad ? 1.0f : 0.0f);
+  out[2 * i + 1] = (float4)(a.mis, broken ? 1.0f : 0.0f);
+}
+
+/* dispersed_ior at the points (ior, dispersion, channel, -) of `points`. */
+__kernel void dispersed_iors(__global const float4* points, uint count, __global float* out) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+#if WP_FEATURE_DISPERSION
+  out[i] = dispersed_ior(points[i].x, points[i].y, (uint)points[i].z);
+#else
+  out[i] = points[i].x;
+#endif
 }
 
 /* sheen.h's and sheen_table.h's constants, for the host's model of the table: out[0..6] =

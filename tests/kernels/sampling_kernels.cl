@@ -15,7 +15,8 @@
  *                azimuth from wo's, radians), sheen = (sheen colour, sheen roughness),
  *                specular = (specular colour, specular factor), aniso = (strength, rotation of
  *                aniso_t from wo's azimuth in radians, -, -), irid = (iridescence factor, film
- *                ior, film thickness in nm, -), dtrans = (diffuse transmission colour, factor).
+ *                ior, film thickness in nm, -), dtrans = (diffuse transmission colour, factor),
+ *                disp = (dispersion factor, the path's channel: 0 all three, 1 R, 2 G, 3 B).
  *   ST_TRIANGLE  sample_triangle (triangle 0 of the small scene in the buffers, light 0 with pmf
  *                1) / triangle_light_pdf times "the ray hits the emitting side"; a.xyz = the
  *                shading point. Frame: world.
@@ -43,7 +44,7 @@
 typedef struct Config {
   uint routine, frame, flags;
   float4 a, color, params;
-  float4 coat, sheen, specular, aniso, irid, dtrans; /* ST_BSDF's extensions */
+  float4 coat, sheen, specular, aniso, irid, dtrans, disp; /* ST_BSDF's extensions */
 } Config;
 
 inline float3 tilted_normal(void) {
@@ -104,7 +105,8 @@ inline Surface config_surface(const Config* c) {
   s.diffuse_transmission = c->dtrans.w;
 #endif
 #if WP_FEATURE_DISPERSION
-  s.dispersion = 0.0f; /* not implemented yet */
+  s.dispersion = c->disp.x;
+  s.channel = (uint)c->disp.y;
 #endif
   return s;
 }
@@ -172,14 +174,31 @@ inline float rel_error3(float3 x, float3 ref) {
   return fmax(rel_error(x.x, ref.x), fmax(rel_error(x.y, ref.y), rel_error(x.z, ref.z)));
 }
 
+/* The index of refraction of s's volume on the path: with KHR_materials_dispersion, once the path
+ * has a channel (1 R 630 nm, 2 G 532 nm, 3 B 465 nm), that wavelength's by the documented formula
+ * n + (n - 1) (dispersion / 20) (523655 / lambda^2 - 1.5168) (docs/light-transport.md), where the
+ * surface transmits into the volume; else the ior. */
+inline float path_ior(const Surface* s) {
+#if WP_FEATURE_DISPERSION
+  if (s->channel != 0u && s->dispersion > 0.0f && (s->flags & WP_SURF_VOLUME) &&
+      s->transmission > 0.0f && s->metallic < 1.0f) {
+    const float lambda = s->channel == 1u ? 630.0f : s->channel == 2u ? 532.0f : 465.0f;
+    return s->ior +
+           (s->ior - 1.0f) * (s->dispersion / 20.0f) * (523655.0f / (lambda * lambda) - 1.5168f);
+  }
+#endif
+  return s->ior;
+}
+
 /* The exact direction of a delta sample wi of surface s seen from wo: the mirror direction above
  * the surface; below it, straight through (thin-walled) or refracted with eta = n_from / n_to,
- * where a WP_SURF_VOLUME surface is entered from the front and left from the back. */
+ * where a WP_SURF_VOLUME surface is entered from the front and left from the back (n: path_ior). */
 inline float3 base_delta_direction(const Surface* s, float3 wo, float3 wi) {
   const float cos_o = dot(wo, s->ns);
   if (dot(wi, s->ns) >= 0.0f) return 2.0f * cos_o * s->ns - wo;
   if (!(s->flags & WP_SURF_VOLUME)) return -wo;
-  const float eta = (s->flags & WP_SURF_FRONT) ? 1.0f / s->ior : s->ior;
+  const float ior = path_ior(s);
+  const float eta = (s->flags & WP_SURF_FRONT) ? 1.0f / ior : ior;
   const float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
   return -eta * wo + (eta * cos_o - sqrt(fmax(0.0f, 1.0f - sin2_t))) * s->ns;
 }
@@ -262,15 +281,15 @@ inline void draw_other(const Config* c, const SceneView* scene, float2 u, float4
 
 #define WP_CONFIG_PARAMS                                                                    \
   uint routine, uint frame, uint flags, float4 a, float4 color, float4 params, float4 coat, \
-      float4 sheen, float4 specular, float4 aniso, float4 irid, float4 dtrans,              \
+      float4 sheen, float4 specular, float4 aniso, float4 irid, float4 dtrans, float4 disp, \
       __global const float4 *positions, __global const uint4 *tri_vertices,                 \
       __global const Material *materials, __global const uint *tri_light,                   \
       __global const LightAlias *light_alias
 
-#define WP_CONFIG_BIND                                                 \
-  const Config cfg = {routine, frame, flags,    a,     color, params,  \
-                      coat,    sheen, specular, aniso, irid,  dtrans}; \
-  const SceneView scene =                                              \
+#define WP_CONFIG_BIND                                                      \
+  const Config cfg = {routine, frame,    flags, a,    color,  params, coat, \
+                      sheen,   specular, aniso, irid, dtrans, disp};        \
+  const SceneView scene =                                                   \
       test_scene(positions, tri_vertices, materials, tri_light, light_alias, (const SceneDesc*)0)
 
 /* From: a configuration, a seed. To: `count` samples, dir = (local direction, SK_* kind) and
@@ -361,6 +380,82 @@ __kernel void lobe_selection(WP_CONFIG_PARAMS, __global float* out) {
 #endif
   out[7] = coat_mirror ? 1.0f : 0.0f;
   out[8] = bsdf_only_delta(&s) ? 1.0f : 0.0f;
+}
+
+/* KHR_materials_dispersion: one sample of an ST_BSDF configuration at a dispersive surface that a
+ * path of all three channels reaches (disp.y = 0), where bsdf_sample chooses the channel. dir =
+ * (local wi, SK_* kind) as draw_bsdf's; check = (1 when the reported pdf is not 0, else 0;
+ * the weight's error against the documented one, 3 f_k |cos| / pdf_k on channel k and 0 on the
+ * others, f_k and pdf_k bsdf_eval's for the surface with the sample's channel k (a delta sample:
+ * 1 unless the weight is finite, >= 0 and 0 on the other channels); distance of a delta sample
+ * from the exact direction of channel k's index (delta_distance); the sample's channel,
+ * BsdfSample.channel, 0 in a program without the feature). */
+__kernel void draw_channel_choice(WP_CONFIG_PARAMS, uint seed, uint count, __global float4* dirs,
+                                  __global float4* checks) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  WP_CONFIG_BIND;
+  (void)scene;
+  const Rng r = rng_make(i, 0u, seed, 0u);
+  const Surface s = config_surface(&cfg);
+  float3 t, b;
+  make_basis(s.ns, &t, &b);
+  const float3 wo = to_world(cfg.a.xyz, t, b, s.ns);
+  const BsdfSample bs =
+      bsdf_sample(&s, wo, rng_get(r, WP_DIM_BSDF_LOBE), rng_get2(r, WP_DIM_BSDF_U));
+  uint k = 0u;
+#if WP_FEATURE_DISPERSION
+  k = bs.channel;
+#endif
+  Surface sk = s; /* the surface on a path of channel k */
+#if WP_FEATURE_DISPERSION
+  sk.channel = k;
+#endif
+  const float3 l = (float3)(dot(bs.wi, t), dot(bs.wi, b), dot(bs.wi, s.ns));
+  float4 check = (float4)(bs.pdf != 0.0f ? 1.0f : 0.0f, 0.0f, 0.0f, (float)k);
+  const float3 mask = (float3)(k == 1u ? 3.0f : 0.0f, k == 2u ? 3.0f : 0.0f, k == 3u ? 3.0f : 0.0f);
+  const float3 w = bs.weight;
+  if (!bs.valid) {
+    dirs[i] = (float4)(l, SK_INVALID);
+  } else if (bs.delta) {
+    dirs[i] = (float4)(l, SK_DELTA);
+    check.z = delta_distance(&sk, wo, bs.wi);
+    const bool ok = isfinite(w.x) && isfinite(w.y) && isfinite(w.z) && w.x >= 0.0f && w.y >= 0.0f &&
+                    w.z >= 0.0f && all(mask > 0.0f || w == 0.0f);
+    check.y = ok ? 0.0f : 1.0f;
+  } else {
+    dirs[i] = (float4)(l, SK_SMOOTH);
+    const BsdfEval e = bsdf_eval(&sk, wo, bs.wi);
+    check.y = rel_error3(w, mask * e.f * fabs(dot(s.ns, bs.wi)) / e.pdf);
+  }
+  checks[i] = check;
+}
+
+/* The whole of one BSDF query for the known answer that dispersion 0 is the BSDF without
+ * dispersion: per sample i, a bsdf_sample (numbers of stream i) and a bsdf_eval at a uniform
+ * direction on the sphere, out[4 i .. 4 i + 3] = (wi, pdf), (weight, eta_scale), (f, pdf of the
+ * eval), (valid, delta, bsdf_only_delta, 0), compared bit for bit by the host across programs. */
+__kernel void bsdf_queries(WP_CONFIG_PARAMS, uint seed, uint count, __global float4* out) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  WP_CONFIG_BIND;
+  (void)scene;
+  const Rng r = rng_make(i, 0u, seed, 0u);
+  const Surface s = config_surface(&cfg);
+  float3 t, b;
+  make_basis(s.ns, &t, &b);
+  const float3 wo = to_world(cfg.a.xyz, t, b, s.ns);
+  const BsdfSample bs =
+      bsdf_sample(&s, wo, rng_get(r, WP_DIM_BSDF_LOBE), rng_get2(r, WP_DIM_BSDF_U));
+  const float2 u = rng_get2(r, WP_DIM_LIGHT_U);
+  const float z = 1.0f - 2.0f * u.x, rho = sqrt(fmax(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * WP_PI * u.y;
+  const BsdfEval e = bsdf_eval(&s, wo, rho * cos(phi) * t + rho * sin(phi) * b + z * s.ns);
+  out[4 * i] = (float4)(bs.wi, bs.pdf);
+  out[4 * i + 1] = (float4)(bs.weight, bs.eta_scale);
+  out[4 * i + 2] = (float4)(e.f, e.pdf);
+  out[4 * i + 3] = (float4)(bs.valid ? 1.0f : 0.0f, bs.delta ? 1.0f : 0.0f,
+                            bsdf_only_delta(&s) ? 1.0f : 0.0f, 0.0f);
 }
 
 /* From: an alias table of `light_count` entries. To: `count` picks (index, reported pmf, what is
