@@ -177,7 +177,7 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
     strength *= a.z;
   }
 #endif
-  s->anisotropy = 0.0f;
+  s->anisotropy = 0.0f, s->aniso_t = (float3)(0.0f); /* no direction: isotropic */
   if (strength > 0.0f) {
     float3 t, b;
     tangent_frame(scene, tv, u, v, n_front, &t, &b);

@@ -56,6 +56,13 @@ case_table() {
     --features all
   check glass_alpha_normal_maps "$models/GlassBrokenWindow/GlassBrokenWindow.glb" --bvh-width 8
   check texture_samplers "$models/TextureSettingsTest/TextureSettingsTest.glb" --bvh-width 2
+  # The material extensions, in the split pipeline (their path-state fields) and fused.
+  check clearcoat_split "$models/ClearCoatTest/ClearCoatTest.glb" --bvh-width 8 --pipeline split
+  check anisotropy_split "$models/AnisotropyStrengthTest/AnisotropyStrengthTest.glb" \
+    --bvh-width 2 --pipeline split
+  check iridescence_split "$models/IridescenceSuzanne/IridescenceSuzanne.glb" --bvh-width 8 \
+    --pipeline split
+  check sheen_specular "$models/GlamVelvetSofa/GlamVelvetSofa.glb" --bvh-width 2
   # (check skips a case whose scene, or environment map from the assets, is absent.)
   check env_map_textured "$models/BoxTextured/BoxTextured.glb" \
     --env "$assets/env/studio_small_03_1k.hdr" --bvh-width 8
