@@ -61,3 +61,9 @@ case_ textransform "$m/TextureTransformMultiTest/TextureTransformMultiTest.glb" 
 case_ emissive "$m/EmissiveStrengthTest/EmissiveStrengthTest.glb"
 case_ cornellbox-glb "$m/CornellBox/CornellBox.glb" --pipeline split
 case_ spheres "$m/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb" --env "$assets/env/venice_sunset_1k.hdr"
+# The material extensions (fused and split give the same MD5s).
+case_ clearcoat "$m/ClearCoatCarPaint/ClearCoatCarPaint.glb" --env-color 1,1,1
+case_ sheen-specular "$m/GlamVelvetSofa/GlamVelvetSofa.glb" --env-color 1,1,1 --pipeline split
+case_ anisotropy "$m/AnisotropyRotationTest/AnisotropyRotationTest.glb" --env-color 1,1,1
+case_ iridescence "$m/IridescenceSuzanne/IridescenceSuzanne.glb" --pipeline split
+case_ variant "$m/MaterialsVariantsShoe/MaterialsVariantsShoe.gltf" --variant street --env-color 1,1,1
