@@ -208,26 +208,37 @@ static inline float coat_weight(const Surface* s, float3 wo) {
 static inline bool has_sheen(const Surface* s) {
   return max3(s->sheen_color) > 0.0f;
 }
-/* 1 - max3(sheen colour) E(|cos|): the share the sheen leaves to the base for one direction
- * (never below 0: E is a table of the lobe's albedo, kernels/sheen.h). */
+/* 1 - max3(sheen colour) E: the share the sheen leaves to the base for one direction whose
+ * sheen albedo is E (never below 0: E exceeds 1 for smooth sheens, kernels/sheen.h). */
+static inline float sheen_leaves_e(const Surface* s, float e) {
+  return fmax(0.0f, 1.0f - max3(s->sheen_color) * e);
+}
+/* The same for the direction at cosine c, E from the table. */
 static inline float sheen_leaves(const Surface* s, float c) {
-  return fmax(0.0f,
-              1.0f - max3(s->sheen_color) * sheen_albedo(fmin(fabs(c), 1.0f), s->sheen_roughness));
+  return sheen_leaves_e(s, sheen_albedo(fmin(fabs(c), 1.0f), s->sheen_roughness));
 }
 #endif
 
 #if WP_BSDF_LAYERED
-/* What scales the base for the pair (wo, wi): 1 - the coat's share at wo, times the sheen's
- * albedo scaling min(1 - max3(c) E(n.wo), 1 - max3(c) E(n.wi)) (the extension's form). */
-static inline float layer_base_scale(const Surface* s, float3 wo, float cos_o, float cos_i) {
-  float k = 1.0f;
+/* What the coat leaves to the layers beneath at wo: 1 - its share (1 without a coat). */
+static inline float coat_leaves(const Surface* s, float3 wo) {
 #if WP_FEATURE_CLEARCOAT
-  k -= coat_weight(s, wo);
+  return 1.0f - coat_weight(s, wo);
+#else
+  (void)s, (void)wo;
+  return 1.0f;
 #endif
+}
+
+/* What scales the base for the pair (wo, wi): what the coat leaves at wo (`top`, coat_leaves),
+ * times the sheen's albedo scaling min(1 - max3(c) E(n.wo), 1 - max3(c) E(n.wi)) (the extension's
+ * form). */
+static inline float layer_base_scale(const Surface* s, float top, float cos_o, float cos_i) {
+  float k = top;
 #if WP_FEATURE_SHEEN
   if (has_sheen(s)) k *= fmin(sheen_leaves(s, cos_o), sheen_leaves(s, cos_i));
 #endif
-  (void)wo, (void)cos_o, (void)cos_i;
+  (void)s, (void)cos_o, (void)cos_i;
   return k;
 }
 #endif
@@ -428,9 +439,10 @@ static inline Lobes bsdf_lobes(const Surface* s, float3 wo, float cos_o, float e
   k = 1.0f - w_coat;
 #endif
 #if WP_FEATURE_SHEEN
-  if (has_sheen(s)) {
-    w_sheen = k * luminance(s->sheen_color) * sheen_albedo(cos_o, s->sheen_roughness);
-    k *= sheen_leaves(s, cos_o);
+  if (has_sheen(s)) { /* one table look-up for both (cos_o > 0: sheen_albedo clamps to 1) */
+    const float e = sheen_albedo(cos_o, s->sheen_roughness);
+    w_sheen = k * luminance(s->sheen_color) * e;
+    k *= sheen_leaves_e(s, e);
   }
 #endif
   w_spec *= k, w_trans *= k, w_diff *= k, w_dtrans *= k;
@@ -562,12 +574,14 @@ static inline void eval_diffuse_transmission(const Surface* s, float3 wo, float3
  * as the rest of the BSDF. */
 static inline void eval_layers(const Surface* s, float3 wo, float3 wi, float cos_o, float cos_i,
                                bool above, Lobes l, BsdfEval* e) {
-  e->f *= layer_base_scale(s, wo, cos_o, cos_i);
-  if (!above) return;
-  float top = 1.0f; /* what the coat leaves to the layers beneath */
+  float coat = 0.0f; /* the coat's share at wo */
 #if WP_FEATURE_CLEARCOAT
-  const float coat = coat_weight(s, wo);
-  top = 1.0f - coat;
+  coat = coat_weight(s, wo);
+#endif
+  const float top = 1.0f - coat; /* what the coat leaves to the layers beneath (coat_leaves) */
+  e->f *= layer_base_scale(s, top, cos_o, cos_i);
+  if (!above) return;
+#if WP_FEATURE_CLEARCOAT
   if (coat > 0.0f && !coat_smooth(s)) {
     const float co = dot(s->nc, wo), ci = dot(s->nc, wi);
     if (co > 0.0f && ci > 0.0f) {
@@ -585,7 +599,6 @@ static inline void eval_layers(const Surface* s, float3 wo, float3 wi, float cos
     e->pdf += l.sheen * cosine_hemisphere_pdf(cos_i);
   }
 #endif
-  (void)top;
 }
 #endif
 
@@ -657,7 +670,7 @@ static inline BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
 /* The layers' scaling of a delta lobe of the base from wo into wi. */
 static inline float3 layered_delta(const Surface* s, float3 wo, float3 wi, float3 weight) {
 #if WP_BSDF_LAYERED
-  return weight * layer_base_scale(s, wo, dot(s->ns, wo), dot(s->ns, wi));
+  return weight * layer_base_scale(s, coat_leaves(s, wo), dot(s->ns, wo), dot(s->ns, wi));
 #else
   (void)s, (void)wo, (void)wi;
   return weight;
