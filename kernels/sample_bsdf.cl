@@ -11,5 +11,5 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   const Surface s = surface_load(paths, slot);
   BounceRandom u;
   bounce_random(path_rng(paths, slot, launch), &u);
-  sample_next_ray(paths, queues, slot, &s, &u);
+  sample_next_ray(paths, queues, slot, &s, path_hit_t(paths, slot), &u);
 }

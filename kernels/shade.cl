@@ -25,13 +25,15 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
      * ray that left the scene, where they would be drawn for nothing (scenes mostly background pay
      * for them otherwise). Paths that end at a hit still draw them for nothing. */
     BounceRandom u = {0.0f, 0.0f, 0.0f, (float2)(0.0f), (float2)(0.0f)};
-    if (path_hit_t(paths, slot) < INFINITY) bounce_random(path_rng(paths, slot, launch), &u);
+    /* Read before the shadow ray takes the hit record's place (shared/path_state.def). */
+    const float t = path_hit_t(paths, slot);
+    if (t < INFINITY) bounce_random(path_rng(paths, slot, launch), &u);
     Surface s;
     if (shade_hit(&scene, paths, launch, slot, &s)) {
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-      shadow = sample_light_ray(&scene, paths, queues, slot, &s, &u);
+      shadow = sample_light_ray(&scene, paths, queues, slot, &s, t, &u);
 #endif
-      sample_next_ray(paths, queues, slot, &s, &u);
+      sample_next_ray(paths, queues, slot, &s, t, &u);
       survives = roulette(paths, queues, launch, slot, u.roulette);
     }
   }

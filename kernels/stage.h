@@ -44,14 +44,19 @@ static inline uint path_sample(Launch launch, uint slot) {
   return launch.sample + slot / launch.wave_pixels;
 }
 
+/* The pixel the path in `slot` renders (pixels numbered row by row from the top). */
+static inline uint path_pixel(Launch launch, uint slot) {
+  return launch.pixel_offset + slot % launch.wave_pixels;
+}
+
 /* The random numbers of the path in `slot` at bounce `bounce`. */
-static inline Rng path_rng_at(Paths paths, uint slot, Launch launch, uint bounce) {
-  return rng_make(path_pixel(paths, slot), path_sample(launch, slot), launch.seed, bounce);
+static inline Rng path_rng_at(uint slot, Launch launch, uint bounce) {
+  return rng_make(path_pixel(launch, slot), path_sample(launch, slot), launch.seed, bounce);
 }
 
 /* The random numbers of the path in `slot` at its current bounce. */
 static inline Rng path_rng(Paths paths, uint slot, Launch launch) {
-  return path_rng_at(paths, slot, launch, path_bounce(paths, slot));
+  return path_rng_at(slot, launch, path_bounce(paths, slot));
 }
 
 /* The random numbers one scattering event draws (rng.h's per-bounce dimensions), all at once

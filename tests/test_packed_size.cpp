@@ -1,4 +1,6 @@
-// The scene's split into device buffers (host/device/device_scene.h), checked before the BVH build:
+// The path state's layout (host/render/path_state.h): its size per path and which fields share
+// memory. The scene's split into device buffers (host/device/device_scene.h), checked before the
+// BVH build:
 // the layout from counts agrees with pack_scene's, its BVH estimate never exceeds a real BVH (so no
 // scene that fits is refused), arrays never cross or exceed a buffer, scenes past the device's
 // buffers are refused before render() builds or caches a BVH, and a scene split over several
@@ -16,6 +18,7 @@
 #include "host/device/device_scene.h"
 #include "host/util/error.h"
 #include "host/lights/light_table.h"
+#include "host/render/path_state.h"
 #include "host/render/render.h"
 #include "tests/scene_factory.h"
 
@@ -321,6 +324,73 @@ TEST(PackedSize, SplitSceneRendersExactlyAsOne) {
     for (float v : one.image.rgb) sum += v;
     EXPECT_GT(sum, 0.0);  // not trivially equal
   }
+}
+
+// The fused pipeline's path state is 112 bytes per path for any feature set (issue 21's bound), the
+// split pipeline's 208 plus 16 per material extension field, AOVs 32 more; and no two fields
+// overlap but the one alias path_state.def declares (the shadow ray's origin over the hit record,
+// fused only): every field's array of `capacity` elements lies inside the buffer, apart from the
+// others.
+TEST(PathState, FusedStateIs112BytesAndSharesOnlyTheHitRecord) {
+  constexpr std::size_t kCapacity = 1000;
+  struct Field {
+    const char* name;
+    dev::uint offset;
+    std::size_t bytes;  // per path, in this layout
+  };
+  const auto fields = [](const PathStateLayout& s, bool aov, bool fused,
+                         const SceneFeatures& features) {
+    std::vector<Field> v;
+    const auto extension = [&](const std::string& needs) {
+      for (const auto& [macro, on] : features.flags())
+        if (on && needs.find(macro) != std::string::npos) return true;
+      return false;
+    };
+#define WP_PATH_FIELD(type, name, description) \
+  v.push_back({#name, s.layout.name, sizeof(dev::type)});
+#define WP_PATH_AOV_FIELD(type, name, description) \
+  v.push_back({#name, s.layout.name, aov ? sizeof(dev::type) : 0});
+#define WP_PATH_SURF_FIELD(type, name, description) \
+  v.push_back({#name, s.layout.name, fused ? 0 : sizeof(dev::type)});
+#define WP_PATH_OPT_FIELD(needs, type, name, description) \
+  v.push_back({#name, s.layout.name, !fused && extension(needs) ? sizeof(dev::type) : 0});
+#define WP_PATH_ALIAS_FIELD(type, name, other, description) \
+  v.push_back({#name, s.layout.name, fused ? 0 : sizeof(dev::type)});
+#include "kernels/shared/path_state.def"
+#undef WP_PATH_ALIAS_FIELD
+#undef WP_PATH_OPT_FIELD
+#undef WP_PATH_SURF_FIELD
+#undef WP_PATH_AOV_FIELD
+#undef WP_PATH_FIELD
+    return v;
+  };
+  for (const bool fused : {true, false})
+    for (const bool aov : {false, true})
+      for (const SceneFeatures& features :
+           {SceneFeatures::all(), SceneFeatures::of(Scene{}, false)}) {
+        SCOPED_TRACE(std::string(fused ? "fused" : "split") + (aov ? ", AOVs" : ""));
+        const PathStateLayout s = path_state_layout(kCapacity, aov, features, fused);
+        const std::vector<Field> v = fields(s, aov, fused, features);
+        std::size_t extensions = 0;
+        for (const Field& f : v)
+          extensions += std::string(f.name).rfind("surf_", 0) == 0 && f.bytes;
+        const std::size_t expected = fused ? 112 : 208 + 16 * (extensions - 5);
+        EXPECT_EQ(s.bytes_per_path, expected + (aov ? 32 : 0));
+        for (std::size_t i = 0; i < v.size(); ++i) {
+          EXPECT_LE(v[i].offset + v[i].bytes * kCapacity, s.bytes) << v[i].name;
+          for (std::size_t j = i + 1; j < v.size(); ++j) {
+            if (!v[i].bytes || !v[j].bytes) continue;
+            const bool apart = v[i].offset + v[i].bytes * kCapacity <= v[j].offset ||
+                               v[j].offset + v[j].bytes * kCapacity <= v[i].offset;
+            EXPECT_TRUE(apart) << v[i].name << " and " << v[j].name << " overlap";
+          }
+        }
+        if (fused) {
+          EXPECT_EQ(s.layout.shadow_o, s.layout.hit);
+        } else {
+          EXPECT_NE(s.layout.shadow_o, s.layout.hit);
+        }
+      }
 }
 
 }  // namespace

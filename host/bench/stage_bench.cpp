@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -47,7 +48,7 @@ struct QueuedRays {
 };
 
 // The rays in queue `queue` of snapshot `s`, as stored for the stage that traces them: closest
-// rays with tmin in ray_o.w and tmax in ray_d.w, shadow rays from tmin 0 to shadow_o.w.
+// rays from tmin in ray_o.w to infinity, shadow rays from tmin 0 to shadow_o.w.
 QueuedRays queued_rays(const Wavefront::Snapshot& s, const dev::PathLayout& layout,
                        std::size_t capacity, dev::uint queue, bool shadow) {
   QueuedRays q;
@@ -56,7 +57,10 @@ QueuedRays queued_rays(const Wavefront::Snapshot& s, const dev::PathLayout& layo
   for (const dev::uint slot : q.slots) {
     const dev::float4 o = field(s, shadow ? layout.shadow_o : layout.ray_o, slot);
     const dev::float4 d = field(s, shadow ? layout.shadow_d : layout.ray_d, slot);
-    q.rays.push_back({{o.x, o.y, o.z}, shadow ? 0.0f : o.w, {d.x, d.y, d.z}, shadow ? o.w : d.w});
+    q.rays.push_back({{o.x, o.y, o.z},
+                      shadow ? 0.0f : o.w,
+                      {d.x, d.y, d.z},
+                      shadow ? o.w : std::numeric_limits<float>::infinity()});
   }
   return q;
 }

@@ -18,7 +18,8 @@ bool uses_any(const SceneFeatures& scene, const std::string& features) {
 }
 }  // namespace
 
-PathStateLayout path_state_layout(std::size_t capacity, bool aov, const SceneFeatures& features) {
+PathStateLayout path_state_layout(std::size_t capacity, bool aov, const SceneFeatures& features,
+                                  bool fused) {
   using namespace dev;
   PathStateLayout s;
   std::size_t offset = 0;
@@ -32,10 +33,15 @@ PathStateLayout path_state_layout(std::size_t capacity, bool aov, const SceneFea
   };
 #define WP_PATH_FIELD(type, name, description) s.layout.name = place(sizeof(type));
 #define WP_PATH_AOV_FIELD(type, name, description) s.layout.name = place(aov ? sizeof(type) : 0);
+#define WP_PATH_SURF_FIELD(type, name, description) s.layout.name = place(fused ? 0 : sizeof(type));
 #define WP_PATH_OPT_FIELD(needs, type, name, description) \
-  s.layout.name = place(uses_any(features, needs) ? sizeof(type) : 0);
+  s.layout.name = place(!fused && uses_any(features, needs) ? sizeof(type) : 0);
+#define WP_PATH_ALIAS_FIELD(type, name, other, description) \
+  s.layout.name = fused ? s.layout.other : place(sizeof(type));
 #include "kernels/shared/path_state.def"
+#undef WP_PATH_ALIAS_FIELD
 #undef WP_PATH_OPT_FIELD
+#undef WP_PATH_SURF_FIELD
 #undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
   s.layout.capacity = static_cast<uint>(capacity);

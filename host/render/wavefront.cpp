@@ -90,7 +90,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   const bool prefetch =
       settings.prefetch && !device.gpu && device.platform_name == "Portable Computing Language";
   options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
-  path_state_ = path_state_layout(wave_paths(), settings.aov, features_);
+  path_state_ = path_state_layout(wave_paths(), settings.aov, features_, settings.fused);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
   try {

@@ -51,7 +51,7 @@ static inline void film_add_aovs(__global ulong* px, float3 albedo, float3 norma
  * path_sample) to the film, so that no two work-items write one pixel. */
 WP_STAGE_FN void accumulate_pixel(Paths paths, Queues queues, Launch launch, __global ulong* film,
                                   uint first) {
-  __global ulong* px = film + (size_t)path_pixel(paths, first) * WP_FILM_STRIDE;
+  __global ulong* px = film + (size_t)path_pixel(launch, first) * WP_FILM_STRIDE;
   for (uint slot = first; slot < launch.path_count; slot += launch.wave_pixels) {
 #if WP_AOV /* every sample once, also one whose radiance is dropped below */
     film_add_aovs(px, path_aov_albedo(paths, slot), path_aov_normal(paths, slot),

@@ -9,7 +9,7 @@
 
 /* Starts the path in `slot` of the wave (slot < launch.path_count). */
 WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, uint slot) {
-  const uint pixel = launch.pixel_offset + slot % launch.wave_pixels;
+  const uint pixel = path_pixel(launch, slot);
   const uint px = pixel % launch.width, py = pixel / launch.width;
   const float2 jitter =
       rng_get2(rng_make(pixel, path_sample(launch, slot), launch.seed, 0u), WP_DIM_PIXEL_X);
@@ -19,11 +19,12 @@ WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, ui
   float tmin;
   camera_ray(camera, ndc, &o, &d, &tmin);
   path_store_ray_o(paths, slot, o, tmin);
-  path_store_ray_d(paths, slot, d, INFINITY);
+  path_store_ray_d(paths, slot, d, 0.0f);
   /* A camera ray: no BSDF sample to weigh against (pdf 0). */
   path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
   path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
-  path_store_info(paths, slot, pixel, 0u, 0u, 0.0f);
+  path_set_flags(paths, slot, 0u);
+  path_set_bounce(paths, slot, 0u);
 #if WP_AOV
   path_store_aov_albedo(paths, slot, (float3)(0.0f), 0.0f);
   path_store_aov_normal(paths, slot, (float3)(0.0f), 0.0f);

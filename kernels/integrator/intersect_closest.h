@@ -18,7 +18,7 @@ WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch laun
   const TraceRay ray = trace_ray(path_ray_origin(paths, slot), path_ray_dir(paths, slot),
                                  path_ray_tmin(paths, slot), key);
   TraceHit hit;
-  if (bvh_trace(scene, &ray, path_ray_tmax(paths, slot), &hit, false))
+  if (bvh_trace(scene, &ray, INFINITY, &hit, false))
     path_store_hit(paths, slot, hit.t, hit.u, hit.v, hit.tri);
   else
     path_store_hit(paths, slot, INFINITY, 0.0f, 0.0f, 0u);

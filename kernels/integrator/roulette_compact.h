@@ -1,8 +1,9 @@
 /* Russian roulette for one path: from bounce rr_depth on, a path survives with probability
  * q = min(1, m / rr_threshold), m its largest throughput component times the eta scale, and its
  * throughput is divided by q (unbiased): a survivor of roulette carries rr_threshold. A path with
- * zero throughput ends. A survivor's bounce count moves on. Used by roulette_compact.cl and the
- * fused shade.cl. */
+ * zero throughput ends. The bounce count moves on for every path, also one that ends here:
+ * trace_shadow, which runs after, finds the bounce of its shadow ray one below it. Used by
+ * roulette_compact.cl and the fused shade.cl. */
 #ifndef WP_INTEGRATOR_ROULETTE_COMPACT_H
 #define WP_INTEGRATOR_ROULETTE_COMPACT_H
 
@@ -11,6 +12,8 @@
 /* Roulette for the path in `slot` with u, its WP_DIM_ROULETTE number: true for a survivor, which
  * the caller pushes to the next bounce's ray queue. */
 WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot, float u) {
+  const uint bounce = path_bounce(paths, slot);
+  path_set_bounce(paths, slot, bounce + 1u);
   const float3 beta = path_throughput(paths, slot);
   /* sample_bsdf catches these first; a NaN is never dropped silently */
   if (!all(isfinite(beta)) || !isfinite(path_bsdf_pdf(paths, slot))) {
@@ -22,12 +25,10 @@ WP_STAGE_FN bool roulette(Paths paths, Queues queues, Launch launch, uint slot, 
    * etaScale): inside glass they would otherwise end paths that are about to leave it, where
    * the factor is undone. */
   const float m = max3(beta) * path_eta_scale(paths, slot) / launch.rr_threshold;
-  const uint bounce = path_bounce(paths, slot);
   if (bounce + 1u >= launch.rr_depth && m < 1.0f) {
     if (u >= m) return false;
     path_set_throughput(paths, slot, beta / m);
   }
-  path_set_bounce(paths, slot, bounce + 1u);
   return true;
 }
 

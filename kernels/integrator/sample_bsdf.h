@@ -10,9 +10,9 @@
 #include "stage.h"
 #include "surface.h"
 
-/* The next ray of the path in `slot` from surface s with the bounce's random numbers u (its lobe
- * choice and direction). */
-WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Surface* s,
+/* The next ray of the path in `slot` from surface s, hit at distance t, with the bounce's random
+ * numbers u (its lobe choice and direction). */
+WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Surface* s, float t,
                                  const BounceRandom* u) {
   const float3 ray_d = path_ray_dir(paths, slot);
   const BsdfSample bs = bsdf_sample(s, -ray_d, u->lobe, u->bsdf_uv);
@@ -24,7 +24,7 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
     return;
   }
   path_set_eta_scale(paths, slot, path_eta_scale(paths, slot) * bs.eta_scale);
-  float pdf = bs.pdf;
+  float pdf = bs.pdf, pane_distance = 0.0f;
 #if WP_FEATURE_TRANSMISSION
   /* Straight through a smooth thin-walled transmitter, which shadow rays pass too (trace_shadow):
    * the path goes on along the direction the previous vertex sampled, so it keeps that sample's
@@ -32,7 +32,7 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
    * pdf there. */
   if (bs.delta && !bsdf_volume(s) && dot(bs.wi, s->ng) < 0.0f) {
     pdf = path_bsdf_pdf(paths, slot);
-    path_set_pane_distance(paths, slot, path_pane_distance(paths, slot) + path_hit_t(paths, slot));
+    pane_distance = path_pane_distance(paths, slot) + t;
   } else
 #endif
   {
@@ -42,12 +42,11 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
 #else
     path_set_flags(paths, slot, bs.delta ? WP_PATH_DELTA : 0u);
 #endif
-    path_set_pane_distance(paths, slot, 0.0f);
   }
   path_store_throughput(paths, slot, next, pdf);
   /* Leave on the side the new direction goes to (below for transmission). */
-  path_store_ray_o(paths, slot, surface_spawn(s, ray_d, path_hit_t(paths, slot), bs.wi), 0.0f);
-  path_store_ray_d(paths, slot, bs.wi, INFINITY);
+  path_store_ray_o(paths, slot, surface_spawn(s, ray_d, t, bs.wi), 0.0f);
+  path_store_ray_d(paths, slot, bs.wi, pane_distance);
 }
 
 #endif /* WP_INTEGRATOR_SAMPLE_BSDF_H */

@@ -11,10 +11,12 @@
 #include "surface.h"
 
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-/* NEE at surface s of the path in `slot` with the bounce's random numbers u (its light pick and
- * light point): a shadow ray for WP_QUEUE_SHADOW, true when there is one (the caller pushes it). */
+/* NEE at surface s, hit at distance t, of the path in `slot` with the bounce's random numbers u
+ * (its light pick and light point): a shadow ray for WP_QUEUE_SHADOW, true when there is one (the
+ * caller pushes it). The fused pipeline's shadow ray takes the hit record's place, so t comes from
+ * the caller, which read it before. */
 WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues queues, uint slot,
-                                  const Surface* s, const BounceRandom* u) {
+                                  const Surface* s, float t, const BounceRandom* u) {
   if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return false;
   const LightSample ls = sample_light(scene, s->p, u->light_pick, u->light_uv);
   if (!(ls.pdf > 0.0f)) return false;
@@ -31,7 +33,7 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
   /* The shadow ray leaves the side of the surface the light is on (transmission can light the
    * back) and, for a light at a finite distance, runs from the moved origin to the light's target
    * point (itself moved off an area light's surface): neither end can hit the surface it is on. */
-  const float3 o = surface_spawn(s, ray_d, path_hit_t(paths, slot), ls.wi);
+  const float3 o = surface_spawn(s, ray_d, t, ls.wi);
   float3 dir = ls.wi;
   float tmax = INFINITY;
   if (ls.dist < INFINITY) {
@@ -40,7 +42,7 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
     dir = to / tmax;
   }
   path_store_shadow_o(paths, slot, o, tmax);
-  path_store_shadow_d(paths, slot, dir, path_bounce(paths, slot));
+  path_set_shadow_dir(paths, slot, dir);
   path_set_shadow_radiance(paths, slot, c);
   return true;
 }

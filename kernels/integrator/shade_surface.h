@@ -13,7 +13,7 @@
 
 /* The fields shade_hit reads first, for the cache hints of the slot ahead. */
 static inline void shade_prefetch(Paths paths, uint slot) {
-  prefetch_path(paths, info, slot);
+  prefetch_path(paths, shadow_l, slot); /* the bounce count */
   prefetch_path(paths, hit, slot);
   prefetch_path(paths, ray_d, slot);
   prefetch_path(paths, throughput, slot);

@@ -29,9 +29,10 @@ static inline void trace_shadow_prefetch(Paths paths, uint slot) {
 WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch launch, uint slot) {
   const float3 o = path_shadow_origin(paths, slot), d = path_shadow_dir(paths, slot);
   const float tmax_light = path_shadow_tmax(paths, slot);
-  /* The random numbers of the bounce that made the ray (sample_lights.h). */
-  const uint key = rng_bits(path_rng_at(paths, slot, launch, path_shadow_bounce(paths, slot)),
-                            WP_DIM_ALPHA_SHADOW);
+  /* The random numbers of the bounce that made the ray (sample_lights.h): the one before the
+   * path's count, which roulette has moved on (roulette_compact.h). */
+  const uint key =
+      rng_bits(path_rng_at(slot, launch, path_bounce(paths, slot) - 1u), WP_DIM_ALPHA_SHADOW);
 #if WP_FEATURE_TRANSMISSION
   const bool finite = tmax_light < INFINITY;
   const float3 target = o + d * tmax_light; /* the end point of a ray of finite length */

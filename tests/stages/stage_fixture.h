@@ -145,6 +145,10 @@ class PathView {
   const unsigned char* raw(wp::dev::uint field, std::uint32_t slot) const {
     return s_.paths.data() + field + std::size_t(slot) * 16;
   }
+  // The path's bounce count and flags, in the w lanes of shadow_l and shadow_d
+  // (kernels/shared/path_state.def).
+  std::uint32_t bounce(std::uint32_t slot) const { return u4(layout_.shadow_l, slot).w; }
+  std::uint32_t flags(std::uint32_t slot) const { return u4(layout_.shadow_d, slot).w; }
   std::uint32_t counter(std::uint32_t q) const { return s_.counters[q]; }
   // Entries [0, counter) of queue q.
   std::vector<std::uint32_t> queue(std::uint32_t q) const {
@@ -282,6 +286,13 @@ class Stages : public ::testing::Test {
   static void poison(wp::dev::uint field, wp::Wavefront& wf = *wf_) {
     wf.write_paths(field, std::vector<float4>(kPaths, kPoison));
   }
+  // Poisons lanes xyz of `field`, keeping w: for shadow_d and shadow_l, whose w lanes hold the
+  // path's flags and bounce count.
+  static void poison_xyz(wp::dev::uint field) {
+    std::vector<float4> v = wf_->read_paths<float4>(field, kPaths);
+    for (float4& e : v) e = {kPoison.x, kPoison.y, kPoison.z, e.w};
+    wf_->write_paths(field, v);
+  }
 
   // The two traversal stages run on both BVH layouts: the device's (wf_, bvh_) and the other one
   // (binary on a CPU device, 8-wide on a GPU), a Wavefront of the same scene and settings made on
@@ -378,7 +389,7 @@ class Stages : public ::testing::Test {
       const dvec3 origin = p - t * dir;
       const std::uint32_t slot = rays[i];
       o[slot] = {float(origin.x), float(origin.y), float(origin.z), 0.0f};
-      d[slot] = {float(dir.x), float(dir.y), float(dir.z), kInf};
+      d[slot] = {float(dir.x), float(dir.y), float(dir.z), 0.0f};  // no panes passed
       h[slot] = {float(t), float(u), float(v), as_float(e.tri)};
     }
     wf_->write_paths(layout().ray_o, o);
