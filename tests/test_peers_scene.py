@@ -12,7 +12,10 @@ and the Lambertian copy (specularFactor 0, all else equal). Node transforms (a p
 with translation, rotation and scale, a child with a mirroring matrix, whose winding must be
 reversed) on a scene written with scenes/gltf_builder.py as .glb; refusals of what the peers
 cannot represent; the PLY writer read back; for --pbr, world-space bounds, wavepath's framing
-camera, and the copy with that camera written in (.glb and .gltf, read back).
+camera, and the copy with that camera written in (.glb and .gltf, read back). Coincident emitters
+(an emitter coplanar with another surface and overlapping it) are found and refused: the
+many-light room of tools/make_many_lights.py converts with its lamps on a grid, and is refused with
+them at random (overlapping) positions or flush with the ceiling.
 """
 
 import math
@@ -27,6 +30,7 @@ sys.path.insert(0, os.path.join(REPO, "tools"))
 sys.path.insert(0, os.path.join(REPO, "scenes"))
 
 import gltf_builder as gb  # noqa: E402
+import make_many_lights as mml  # noqa: E402
 import peers_scene as ps  # noqa: E402
 
 BOX = os.path.join(REPO, "scenes", "cornell_box.gltf")
@@ -260,6 +264,70 @@ class NearestTextures(unittest.TestCase):
         doc = {"materials": [{"normalTexture": {"index": 0}, "name": "a"}, {"name": "b"}]}
         ps.no_normal_maps(doc)
         self.assertEqual(doc["materials"], [{"name": "a"}, {"name": "b"}])
+
+
+def _mesh(name, material, *triangles):
+    positions = [p for t in triangles for p in t]
+    return {"name": name, "material": material, "positions": positions,
+            "triangles": [(3 * k, 3 * k + 1, 3 * k + 2) for k in range(len(triangles))]}
+
+
+class CoincidentEmitters(unittest.TestCase):
+    """peers_scene.coincident_emitters and load()'s refusal (docs/peers.md, notes: such lamps made
+    Cycles 3% darker than wavepath and Mitsuba, and wavepath's light and BSDF sampling disagree)."""
+
+    MATERIALS = [{"emission": (1.0, 1.0, 1.0)}, {"emission": (0.0, 0.0, 0.0)}]
+
+    def found(self, *meshes):
+        return ps.coincident_emitters({"meshes": list(meshes), "materials": self.MATERIALS})
+
+    def test_pairs(self):
+        lamp = _mesh("lamp", 0, ((0, 1, 0), (0, 1, 1), (1, 1, 0)))  # facing -Y
+        self.assertEqual(self.found(lamp), [])
+        # Coplanar and overlapping, either facing, emitter or not: found, the area of the overlap.
+        for other in (((0.5, 1, 0), (0.5, 1, 1), (1.5, 1, 0)),    # the same facing
+                      ((0.5, 1, 0), (1.5, 1, 0), (0.5, 1, 1))):   # facing +Y
+            for material in (0, 1):
+                (hit,) = self.found(lamp, _mesh("other", material, other))
+                self.assertEqual(hit[:2], ("lamp", "other"))
+                self.assertAlmostEqual(hit[2], 0.125, delta=1e-9)
+        # A shared edge, a parallel plane 1 mm off, a perpendicular triangle: none.
+        self.assertEqual(self.found(lamp, _mesh("edge", 0, ((0, 1, 1), (1, 1, 1), (1, 1, 0)))), [])
+        self.assertEqual(self.found(lamp, _mesh("off", 1, ((0, 1.001, 0), (0, 1.001, 1),
+                                                          (1, 1.001, 0)))), [])
+        self.assertEqual(self.found(lamp, _mesh("wall", 1, ((0, 0, 0), (0, 2, 0), (0, 0, 2)))), [])
+        # Two non-emitters may coincide (not this check's business).
+        self.assertEqual(self.found(_mesh("a", 1, ((0, 1, 0), (0, 1, 1), (1, 1, 0))),
+                                    _mesh("b", 1, ((0, 1, 0), (0, 1, 1), (1, 1, 0)))), [])
+
+    def load_room(self, **kw):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "room.gltf")
+            mml.build(**kw).write(path)
+            return ps.load(path)
+
+    def test_many_light_room_converts(self):
+        scene = self.load_room()
+        s = ps.summary(scene)
+        self.assertEqual(len(s["emitters"]), 300)
+        for e in s["emitters"]:
+            self.assertEqual(e["normal"], (0.0, -1.0, 0.0))
+            self.assertAlmostEqual(e["area"], mml.LAMP ** 2, delta=1e-7)
+        self.assertEqual(len({e["radiance"] for e in s["emitters"]}), 300)  # coloured
+        by_name = {m["name"]: m for m in scene["materials"]}
+        self.assertEqual(by_name["black"]["reflectance"], (0.0, 0.0, 0.0))
+        self.assertEqual(by_name["grey"]["reflectance"], (0.5, 0.5, 0.5))
+        self.assertTrue(all(m["specular"] == 0.0 and not m["double_sided"]
+                            for m in scene["materials"]))
+        self.assertEqual(ps.coincident_emitters(scene), [])
+
+    def test_overlapping_lamps_refused(self):
+        with self.assertRaisesRegex(ps.ConversionError, "coincide with other surfaces"):
+            self.load_room(layout="random", lamp=0.1)
+
+    def test_lamps_flush_with_the_ceiling_refused(self):
+        with self.assertRaisesRegex(ps.ConversionError, "'lamp0' and 'ceiling'"):
+            self.load_room(lamps=4, drop=0.0)
 
 
 class Ply(unittest.TestCase):

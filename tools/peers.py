@@ -45,7 +45,9 @@ VENV_MARK = "WP_PEERS_IN_VENV"
 
 DESCRIPTION = """\
 Converts the scene (tools/peers_scene.py: world-space triangle meshes, Lambertian materials,
-emitters, point lights, the first perspective camera; anything else is refused) for each peer.
+emitters, point lights, the first perspective camera; anything else is refused, and so is an
+emitter coplanar with and overlapping another surface, which each renderer resolves its own way:
+docs/peers.md, notes) for each peer.
 A glTF material with metallic 0 is not Lambertian: glTF, and wavepath, put a rough specular layer
 (Fresnel 0.04 at normal incidence, 1 at grazing) over the diffuse one, which neither peer's diffuse
 BSDF has. So when a material lacks KHR_materials_specular specularFactor 0, the benchmark renders
@@ -230,7 +232,7 @@ def _cycles_material(bpy, mat):
         links.new(diffuse.outputs[0], add.inputs[0])
         links.new(emission.outputs[0], add.inputs[1])
         shader = add.outputs[0]
-        m.cycles.emission_sampling = "FRONT_AND_BACK" if mat["double_sided"] else "FRONT"
+        m.cycles.emission_sampling = "FRONT_BACK" if mat["double_sided"] else "FRONT"
     else:
         m.cycles.emission_sampling = "NONE"
     if not mat["double_sided"]:
@@ -608,7 +610,10 @@ def convert(a):
     copy (specularFactor 0) when a material has glTF's default specular layer."""
     os.makedirs(a.work, exist_ok=True)
     a.render_scene = a.scene
-    scene = peers_scene.load(a.scene)
+    try:
+        scene = peers_scene.load(a.scene)
+    except peers_scene.ConversionError as e:
+        sys.exit("peers.py: error: %s" % e)
     if any(m["specular"] != 0.0 for m in scene["materials"]):
         if not a.scene.endswith(".gltf"):
             sys.exit("peers.py: error: %s has materials with glTF's specular layer; the Lambertian "

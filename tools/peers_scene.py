@@ -11,6 +11,7 @@ Standard library only, so that tests/test_peers_scene.py runs without PyPI.
     scene["point_lights"]  # [{"name", "position": (x, y, z), "intensity": (r, g, b) W/sr}]
     scene["camera"]        # {"position", "forward", "up" (unit vectors), "yfov" (radians),
                            #  "aspect" (width / height, None when the glTF leaves it open)}
+    peers_scene.coincident_emitters(scene)  # [(emitter, other mesh, area)]: coplanar overlaps
     peers_scene.write_ply(path, mesh)   # binary little-endian PLY of one mesh
     peers_scene.lambertian_copy(path, out)  # the .gltf with specularFactor 0 on every material
     peers_scene.bounds(path)            # (lo, hi): world-space bounds of the triangle vertices
@@ -27,11 +28,13 @@ KHR_materials_specular specularFactor 0: without it, glTF (and wavepath) put a r
 with Fresnel reflectance 0.04 (rising to 1 at grazing angles) over the diffuse one. Each material's
 "specular" is that factor (1 when absent); lambertian_copy() writes a copy of a .gltf with 0 on
 every material, the scene the peers can match. Anything else (textures, metals, transmission, spot
-lights, ...) is a ConversionError naming it, never a silent approximation. Units and conventions are
-wavepath's (scenes/README.md): metres, +Y up, linear RGB, emission = emissiveFactor x
-emissiveStrength as radiance, point light intensity x colour read as W/sr; a triangle's front is the
-side from which its vertices run counter-clockwise, and a material that is not double-sided is
-invisible from the back (wavepath culls back faces: rays pass through them).
+lights, ...) is a ConversionError naming it, never a silent approximation; so is an emitter that
+coincides with another surface (coplanar and overlapping: coincident_emitters()), a scene that
+does not define its image. Units and conventions are wavepath's (scenes/README.md): metres, +Y up,
+linear RGB, emission = emissiveFactor x emissiveStrength as radiance, point light intensity x
+colour read as W/sr; a triangle's front is the side from which its vertices run counter-clockwise,
+and a material that is not double-sided is invisible from the back (wavepath culls back faces: rays
+pass through them).
 
 bounds(), framing_camera(), camera(), with_camera() and copy_gltf() work on any glTF (textures
 and all): they serve the --pbr mode of tools/peers.py, where Cycles imports the file itself and
@@ -282,7 +285,129 @@ def load(path):
         "yfov": float(cam["perspective"]["yfov"]),
         "aspect": cam["perspective"].get("aspectRatio"),
     }
+    found = coincident_emitters(scene)
+    if found:
+        raise ConversionError(
+            "%s: emitters coincide with other surfaces (coplanar and overlapping) in %d pair(s) "
+            "of meshes, e.g. %s: the renderers resolve coincident surfaces differently (and "
+            "wavepath's own light and BSDF sampling disagree there), so the scene does not define "
+            "its image; move them apart" % (path, len(found), "; ".join(
+                "%r and %r (overlap %.3g m^2)" % f for f in found[:3])))
     return scene
+
+
+# ---- Coincident emitters -------------------------------------------------------------------------
+
+COINCIDENT_TOLERANCE = 1e-5  # of the scene's bounding-box diagonal
+
+
+def _clip_convex(poly, a, b):
+    """The part of 2D polygon `poly` on the left of the directed line a -> b."""
+    def side(p):
+        return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+    out = []
+    for k, p in enumerate(poly):
+        q = poly[(k + 1) % len(poly)]
+        sp, sq = side(p), side(q)
+        if sp >= 0.0:
+            out.append(p)
+        if (sp >= 0.0) != (sq >= 0.0):
+            t = sp / (sp - sq)
+            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
+    return out
+
+
+def _area2(poly):
+    """Signed area of a 2D polygon (counter-clockwise positive)."""
+    return 0.5 * sum(poly[k][0] * poly[(k + 1) % len(poly)][1]
+                     - poly[(k + 1) % len(poly)][0] * poly[k][1] for k in range(len(poly)))
+
+
+def coincident_emitters(scene, tolerance=COINCIDENT_TOLERANCE):
+    """[(emitter mesh name, other mesh name, overlap area m^2 of the first overlapping pair of
+    triangles found)], one per pair of meshes (load() refuses a scene with any), where a
+    triangle of an emissive material and another triangle (of any material, either facing) lie in
+    one plane (every vertex of the other within `tolerance` x the bounding-box diagonal of the
+    emitter's plane) and overlap with positive area (more than 1e-6 of the smaller triangle's; a
+    shared edge is no overlap). Such a scene does not define its image: which of two coincident
+    surfaces a ray hits is up to each renderer's intersection code, and the light sampled on the
+    hidden part of an emitter is found by light sampling but not by BSDF sampling."""
+    tris = []  # (mesh index, (a, b, c), emissive)
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+    for mi, mesh in enumerate(scene["meshes"]):
+        emissive = max(scene["materials"][mesh["material"]]["emission"]) > 0.0
+        for t in mesh["triangles"]:
+            v = tuple(tuple(mesh["positions"][k]) for k in t)
+            tris.append((mi, v, emissive))
+            for p in v:
+                lo = [min(lo[i], p[i]) for i in range(3)]
+                hi = [max(hi[i], p[i]) for i in range(3)]
+    if not any(e for _, _, e in tris):
+        return []
+    tol = tolerance * math.sqrt(sum((hi[i] - lo[i]) ** 2 for i in range(3)))
+    # A uniform grid of the emitter triangles' bounding boxes (cells of the largest emitter's
+    # extent, at least 1/64 of the scene's), queried with every triangle's.
+    emitters = [k for k, (_, _, e) in enumerate(tris) if e]
+    size = max(max(max(p[i] for p in tris[k][1]) - min(p[i] for p in tris[k][1])
+                   for i in range(3)) for k in emitters)
+    cell = max(size, max(hi[i] - lo[i] for i in range(3)) / 64.0, tol, 1e-30)
+
+    def cells(v):
+        a = [int(math.floor((min(p[i] for p in v) - tol - lo[i]) / cell)) for i in range(3)]
+        b = [int(math.floor((max(p[i] for p in v) + tol - lo[i]) / cell)) for i in range(3)]
+        return [(x, y, z) for x in range(a[0], b[0] + 1) for y in range(a[1], b[1] + 1)
+                for z in range(a[2], b[2] + 1)]
+
+    grid = {}
+    for k in emitters:
+        for c in cells(tris[k][1]):
+            grid.setdefault(c, []).append(k)
+    found, tested = {}, set()
+    for j, (mj, vj, ej) in enumerate(tris):
+        candidates = set()
+        for c in cells(vj):
+            candidates.update(grid.get(c, ()))
+        for k in candidates:
+            if k == j:
+                continue
+            if ej:  # both emissive: test the pair once
+                if (min(j, k), max(j, k)) in tested:
+                    continue
+                tested.add((min(j, k), max(j, k)))
+            mk, vk, _ = tris[k]
+            key = (min(mk, mj), max(mk, mj)) if ej else (mk, mj)
+            if key in found:
+                continue
+            area = _coplanar_overlap(vk, vj, tol)
+            if area > 0.0:
+                found[key] = area
+    names = [m["name"] for m in scene["meshes"]]
+    return [(names[a], names[b], area) for (a, b), area in found.items()]
+
+
+def _coplanar_overlap(e, t, tol):
+    """Overlap area of triangle t with triangle e when t lies in e's plane (within tol), else 0."""
+    area_e, n = triangle_area(*e)
+    area_t, _ = triangle_area(*t)
+    if area_e == 0.0 or area_t == 0.0:
+        return 0.0
+    n = [c / (2.0 * area_e) for c in n]
+    if any(abs(sum(n[i] * (p[i] - e[0][i]) for i in range(3))) > tol for p in t):
+        return 0.0
+    drop = max(range(3), key=lambda i: abs(n[i]))  # project onto the other two axes
+    u, v = [i for i in range(3) if i != drop]
+    pe = [(p[u], p[v]) for p in e]
+    pt = [(p[u], p[v]) for p in t]
+    if _area2(pe) < 0.0:
+        pe.reverse()
+    poly = pt
+    for k in range(3):
+        poly = _clip_convex(poly, pe[k], pe[(k + 1) % 3])
+        if len(poly) < 3:
+            return 0.0
+    scale = 1.0 / abs(n[drop])  # projected area back to the plane's
+    overlap = abs(_area2(poly)) * scale
+    return overlap if overlap > 1e-6 * min(area_e, area_t) else 0.0
 
 
 # ---- Geometry and cameras of any glTF (the --pbr mode) -------------------------------------------
