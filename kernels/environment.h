@@ -27,6 +27,7 @@
 #define WP_ENVIRONMENT_H
 
 #include "scene.h"
+#include "sampling.h"
 
 #if WP_FEATURE_ENVIRONMENT
 
@@ -131,8 +132,8 @@ static inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, f
 #endif
   const float z = 1.0f - 2.0f * u.x;
   const float r = sqrt(fmax(0.0f, 1.0f - z * z));
-  const float phi = 2.0f * WP_PI * u.y;
-  *dir = (float3)(r * cos(phi), z, r * sin(phi));
+  const float2 cs = cos_sin_turn(u.y);
+  *dir = (float3)(r * cs.x, z, r * cs.y);
   *pdf = 1.0f / (4.0f * WP_PI);
   return scene->desc->background.xyz;
 }

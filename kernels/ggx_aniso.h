@@ -111,10 +111,10 @@ static inline float3 sample_ggx_aniso_visible_normal(float3 wo, float ax, float 
       len2 > 0.0f ? (float3)(-vh.y, vh.x, 0.0f) * rsqrt(len2) : (float3)(1.0f, 0.0f, 0.0f);
   const float3 t2 = cross(vh, t1);
   const float r = sqrt(u.x);
-  const float phi = 2.0f * WP_PI * u.y;
-  const float p1 = r * cos(phi);
+  const float2 cs = cos_sin_turn(u.y);
+  const float p1 = r * cs.x;
   const float s = 0.5f * (1.0f + vh.z);
-  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * sin(phi);
+  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * cs.y;
   const float3 nh = p1 * t1 + p2 * t2 + sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
   return normalize((float3)(ax * nh.x, ay * nh.y, fmax(1e-7f, nh.z)));
 }

@@ -144,7 +144,11 @@ static inline LightSample sample_light(const SceneView* scene, float3 p, float u
     s.dist = INFINITY;
     s.delta = false;
   } else {
+#if WP_FEATURE_PUNCTUAL_LIGHTS
     s = sample_punctual(light, p);
+#else
+    s.pdf = 0.0f; /* no such light in the program's scenes */
+#endif
   }
   s.pdf *= pmf;
   return s;

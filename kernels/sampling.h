@@ -21,6 +21,19 @@ static inline float2 cos_sin_quarter(float t) {
   return (float2)(c, s);
 }
 
+/* (cos, sin) of the angle 2 pi u for u in [0, 1]: the nearest quarter turn q and the rest t,
+ * |t| <= pi/4 (x - q is exact), by cos_sin_quarter, rotated by q quarter turns. No call to the
+ * library's cos and sin, whose argument reduction PoCL keeps out of line. */
+static inline float2 cos_sin_turn(float u) {
+  const float x = 4.0f * u;
+  const float q = floor(x + 0.5f);
+  const float2 cs = cos_sin_quarter((x - q) * (0.5f * WP_PI));
+  const int k = (int)q & 3;
+  const float c = k == 0 ? cs.x : k == 1 ? -cs.y : k == 2 ? -cs.x : cs.y;
+  const float s = k == 0 ? cs.y : k == 1 ? cs.x : k == 2 ? -cs.y : -cs.x;
+  return (float2)(c, s);
+}
+
 /* Cosine-weighted hemisphere (concentric disk mapping, then lifted): pdf = cos(theta) / pi. The
  * disk angle is (pi/4) q or pi/2 - (pi/4) q with |q| <= 1, so cos_sin_quarter serves both. */
 static inline float3 sample_cosine_hemisphere(float2 u) {
@@ -85,10 +98,10 @@ static inline float3 sample_ggx_visible_normal(float3 v, float alpha, float2 u) 
       len2 > 0.0f ? (float3)(-vh.y, vh.x, 0.0f) * rsqrt(len2) : (float3)(1.0f, 0.0f, 0.0f);
   const float3 t2 = cross(vh, t1);
   const float r = sqrt(u.x);
-  const float phi = 2.0f * WP_PI * u.y;
-  const float p1 = r * cos(phi);
+  const float2 cs = cos_sin_turn(u.y);
+  const float p1 = r * cs.x;
   const float s = 0.5f * (1.0f + vh.z);
-  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * sin(phi);
+  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * cs.y;
   const float3 nh = p1 * t1 + p2 * t2 + sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
   return normalize((float3)(alpha * nh.x, alpha * nh.y, fmax(1e-7f, nh.z)));
 }

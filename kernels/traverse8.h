@@ -5,7 +5,9 @@
  * The order and arithmetic are those of the CPU reference (bvh/, width 8): all 8 boxes tested
  * against the current closest t; then in lane order, leaves intersected at once, inner children
  * collected and pushed nearest-on-top; the next node popped; an entry farther than the closest hit
- * skipped. Included by traverse.h, which provides TraceRay, TraceHit and the alpha hook.
+ * skipped. Any hit may visit the children in any order (the reference's answer does not depend on
+ * it: bvh_trace explains). Included by traverse.h, which provides TraceRay, TraceHit and the alpha
+ * hook.
  */
 #ifndef WP_TRAVERSE8_H
 #define WP_TRAVERSE8_H
@@ -28,12 +30,15 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
   const int4 mixed =
       ((u_ < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f)) & ((u_ > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f));
   const float4 det = u_ + v_ + w_;
+  const uint4 flags = b->flags;
+  const int4 cull = ((flags & WP_TRI_CULL_BACKFACE) != 0) & (det < 0.0f);
+  /* Most blocks end here, before the division (the same hits). */
+  const int4 inside = ~mixed & (det != 0.0f) & ~cull;
+  if (!any(inside)) return false;
   const float4 inv = 1.0f / det;
   const float4 t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;
   const float4 u = v_ * inv, v = w_ * inv;
-  const uint4 flags = b->flags;
-  const int4 cull = ((flags & WP_TRI_CULL_BACKFACE) != 0) & (det < 0.0f);
-  int4 ok = ~mixed & (det != 0.0f) & ~cull & (t > r->tmin);
+  int4 ok = inside & (t > r->tmin);
 #if WP_FEATURE_ALPHA
   if (!any(ok)) return false;
   /* Lanes in order, strictly closer replaces: the reference's rule. */
@@ -58,8 +63,8 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
 #else
   (void)scene;
   /* Without alpha that rule picks the smallest t below the closest so far, the lowest lane among
-   * equals: found here without a branch per lane, the same hit (a branch per lane was slower on PoCL:
-   * docs/performance.md, "Closest lane of a triangle block"). */
+   * equals: found here without a branch per lane, the same hit (a branch per lane was slower on
+   * PoCL: docs/performance.md, "Closest lane of a triangle block"). */
   ok &= t < hit->t;
   if (!any(ok)) return false;
   const float4 tm = select((float4)(INFINITY), t, ok);
@@ -92,10 +97,49 @@ static inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref
   return found;
 }
 
-/* Closest hit (any_hit = false) or any hit (true) in (tmin, tmax). */
+/* Cache hints (WP_PREFETCH: PoCL's CPU devices; a no-op elsewhere), through an integer as in
+ * stage.h. */
+#if WP_PREFETCH
+#define bvh_prefetch(p) __builtin_prefetch((const void*)(size_t)(p), 0, 3)
+#else
+#define bvh_prefetch(p) ((void)(p))
+#endif
+
+/* The reference's minimum and maximum (bvh/traverse_common.h, fmin2 and fmax2), one instruction
+ * each on a CPU, where fmin and fmax take three (their NaN rule). */
+static inline float8 min8(float8 a, float8 b) {
+  return select(a, b, b < a);
+}
+static inline float8 max8(float8 a, float8 b) {
+  return select(a, b, a < b);
+}
+
+/* Bit i set where lane i of `m` is set (true: all bits of the lane). */
+static inline int lane_bits8(int8 m) {
+  const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  const int4 b4 = b.lo | b.hi;
+  const int2 b2 = b4.lo | b4.hi;
+  return b2.x | b2.y;
+}
+
+/* The lowest set bit's index (bits != 0). */
+static inline int lowest_bit(int bits) {
+  return 31 - clz(bits & -bits);
+}
+
+/* Closest hit (any_hit = false) or any hit (true) in (tmin, tmax).
+ *
+ * The visiting order is the reference's (the file comment): at a node, every entered leaf in lane
+ * order, then the entered inner children by tnear. Without any_hit the nearest of them is visited
+ * next directly and the others are pushed, farthest first, the lower lane on top among equal
+ * tnear, and an entry farther than the closest hit is skipped (so one that is already farther
+ * when the node's leaves are done is not pushed at all); with any_hit, which returns at the first
+ * hit whatever the order, hit->t stays the ray's tmax, so nothing is ever skipped and the children
+ * are visited in lane order with no distances kept. */
 static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
                              bool any_hit) {
   __global const BvhNode8* nodes = (__global const BvhNode8*)scene->nodes;
+  __global const TriBlock4* blocks = (__global const TriBlock4*)scene->tris;
   int stack_node[WP_BVH8_STACK_SIZE];
   float stack_t[WP_BVH8_STACK_SIZE];
   int sp = 0;
@@ -104,49 +148,99 @@ static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tm
   hit->t = tmax;
   for (;;) {
     __global const BvhNode8* n = nodes + node;
-    const float8 tx0 = (n->lo_x - r->ox) * r->ix, tx1 = (n->hi_x - r->ox) * r->ix;
-    const float8 ty0 = (n->lo_y - r->oy) * r->iy, ty1 = (n->hi_y - r->oy) * r->iy;
-    const float8 tz0 = (n->lo_z - r->oz) * r->iz, tz1 = (n->hi_z - r->oz) * r->iz;
-    const float8 tnear =
-        fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), (float8)(r->tmin)));
-    const float8 tfar =
-        fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), (float8)(hit->t)));
-    const int8 entered = tnear <= tfar;
-    if (any(entered)) {
-      int el[8], cl[8];
+    __global const float8* box = (__global const float8*)n;
+    /* The slab test with each axis's near and far planes picked by the direction's sign (lo <= hi
+     * in every box: bvh_check_wide), the same values as min and max of both planes' distances. */
+    const float8 tnx = (box[r->near_x] - r->ox) * r->ix, tfx = (box[r->near_x ^ 1] - r->ox) * r->ix;
+    const float8 tny = (box[r->near_y] - r->oy) * r->iy, tfy = (box[r->near_y ^ 1] - r->oy) * r->iy;
+    const float8 tnz = (box[r->near_z] - r->oz) * r->iz, tfz = (box[r->near_z ^ 1] - r->oz) * r->iz;
+    const float8 tnear = max8(max8(tnx, tny), max8(tnz, (float8)(r->tmin)));
+    const float8 tfar = min8(min8(tfx, tfy), min8(tfz, (float8)(hit->t)));
+    const int8 child = n->child;
+    const int entered = lane_bits8(tnear <= tfar);
+    int leaves = entered & lane_bits8(child < 0);
+    int inner = entered & lane_bits8(child > 0);
+    __global const int* cl = (__global const int*)&n->child;
+#if WP_PREFETCH
+    /* Every child about to be visited or pushed: their cache misses overlap instead of coming one
+     * after another. */
+    for (int bits = leaves | inner; bits != 0; bits &= bits - 1) {
+      const int c = cl[lowest_bit(bits)];
+      if (c < 0) {
+        __global const char* p = (__global const char*)(blocks + (~c >> 2));
+        bvh_prefetch(p);
+        bvh_prefetch(p + 64);
+        bvh_prefetch(p + 128);
+        bvh_prefetch(p + sizeof(TriBlock4) - 1);
+      } else {
+        __global const char* p = (__global const char*)(nodes + c);
+        bvh_prefetch(p);
+        bvh_prefetch(p + 64);
+        bvh_prefetch(p + 128);
+        bvh_prefetch(p + sizeof(BvhNode8) - 1);
+      }
+    }
+#endif
+    for (; leaves != 0; leaves &= leaves - 1) {
+      if (leaf8_test(scene, r, cl[lowest_bit(leaves)], hit, any_hit)) {
+        found = true;
+        if (any_hit) return true;
+      }
+    }
+    if (any_hit) {
+      if (inner != 0) {
+        node = cl[lowest_bit(inner)];
+        for (inner &= inner - 1; inner != 0; inner &= inner - 1)
+          stack_node[sp++] = cl[lowest_bit(inner)];
+        continue;
+      }
+      if (sp == 0) return false;
+      node = stack_node[--sp];
+      continue;
+    }
+    /* Children already farther than the closest hit would be skipped when popped. */
+    inner &= lane_bits8(tnear <= (float8)(hit->t));
+    if (inner != 0) {
       float tl[8];
-      vstore8(entered, 0, el);
-      vstore8(n->child, 0, cl);
       vstore8(tnear, 0, tl);
-      /* Inner children, kept sorted with the nearest last (it goes on top of the stack). */
-      int inner_node[8];
-      float inner_t[8];
-      int count = 0;
-      for (int i = 0; i < 8; ++i) {
-        if (!el[i]) continue;
-        if (cl[i] < 0) {
-          if (leaf8_test(scene, r, cl[i], hit, any_hit)) {
-            found = true;
-            if (any_hit) return true;
-          }
-          continue;
-        }
-        if (cl[i] == 0) continue; /* an unused slot (node 0 is the root, nobody's child) */
-        /* Insertion: entries stay in decreasing tnear; a tie goes below the earlier lane. */
-        int j = count++;
-        while (j > 0 && inner_t[j - 1] <= tl[i]) {
-          inner_t[j] = inner_t[j - 1];
-          inner_node[j] = inner_node[j - 1];
-          --j;
-        }
-        inner_t[j] = tl[i];
-        inner_node[j] = cl[i];
+      const int i = lowest_bit(inner);
+      inner &= inner - 1;
+      if (inner == 0) {
+        node = cl[i];
+        continue;
       }
-      for (int j = 0; j < count; ++j) {
-        stack_node[sp] = inner_node[j];
-        stack_t[sp] = inner_t[j];
+      const int j = lowest_bit(inner);
+      inner &= inner - 1;
+      if (inner == 0) {
+        /* Two: the nearer first, lane i (< j) among equals. */
+        const bool j_first = tl[j] < tl[i];
+        stack_node[sp] = cl[j_first ? i : j];
+        stack_t[sp] = tl[j_first ? i : j];
         ++sp;
+        node = cl[j_first ? j : i];
+        continue;
       }
+      /* More: insertion into the stack in lane order, entries in decreasing tnear, a later lane
+       * below the earlier ones among equals; then the top (the nearest) is visited. */
+      const int base = sp;
+      stack_node[sp] = cl[i];
+      stack_t[sp] = tl[i];
+      ++sp;
+      inner |= 1 << j;
+      for (; inner != 0; inner &= inner - 1) {
+        const int k = lowest_bit(inner);
+        const float t = tl[k];
+        int e = sp++;
+        while (e > base && stack_t[e - 1] <= t) {
+          stack_t[e] = stack_t[e - 1];
+          stack_node[e] = stack_node[e - 1];
+          --e;
+        }
+        stack_t[e] = t;
+        stack_node[e] = cl[k];
+      }
+      node = stack_node[--sp];
+      continue;
     }
     /* Next: the top entry that can still hold something closer. */
     for (;;) {

@@ -53,7 +53,9 @@ typedef struct BvhNode {
  *          block array (1 to WP_BVH8_MAX_LEAF_BLOCKS blocks);
  * an unused slot has child 0 (node 0 is the root, never a child: traversal skips it) and the box
  * lo = hi = +INFINITY, which keeps out every ray with a finite tmax (a ray with tmax = INFINITY
- * and no negative direction component does enter it, with tnear = tfar = INFINITY). */
+ * and no negative direction component does enter it, with tnear = tfar = INFINITY). A used box has
+ * lo <= hi on every axis (bvh_check_wide checks it): traverse8.h takes each axis's near plane by
+ * the sign of the ray's direction. */
 #define WP_BVH8_WIDTH 8
 #define WP_BVH8_MAX_LEAF_BLOCKS 4
 /* Embree's maxDepth for the wide tree; the traversal stack holds at most 7 entries per level. */
