@@ -14,6 +14,10 @@
 //   4. The next node is popped; an entry whose tnear > the current closest t is skipped;
 //      traversal ends when the stack is empty. Any-hit (occluded) returns at the first hit.
 //
+// An any-hit answer does not depend on this order: until its first hit the closest t stays the
+// ray's tmax, so every box it enters is entered in whatever order the nodes come, and nothing is
+// skipped; kernels/traverse8.h visits the children in lane order there, unsorted.
+//
 // child == 0 is an unused slot (node 0 is the root, nobody's child) and is never visited. Its box
 // (lo = hi = +INFINITY) keeps out every ray with a finite tmax, but a ray with tmax = +INFINITY
 // and no negative direction component enters it (all slab distances +INFINITY, so tnear = tfar =

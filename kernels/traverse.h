@@ -28,9 +28,6 @@ typedef struct TraceRay {
   int kx, ky, kz;
   float sx, sy, sz;
   float o_kx, o_ky, o_kz;
-  /* The wide layout's slab test: the index of each axis's near plane among a BvhNode8's six box
-   * arrays (lo_x, hi_x, lo_y, hi_y, lo_z, hi_z); the far plane's is that ^ 1. */
-  int near_x, near_y, near_z;
 } TraceRay;
 
 typedef struct TraceHit {
@@ -46,9 +43,6 @@ static inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key)
   TraceRay r;
   r.ox = o.x, r.oy = o.y, r.oz = o.z;
   r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
-  r.near_x = r.ix < 0.0f ? 1 : 0;
-  r.near_y = r.iy < 0.0f ? 3 : 2;
-  r.near_z = r.iz < 0.0f ? 5 : 4;
   r.tmin = tmin;
   r.alpha_key = alpha_key;
   const float ax = fabs(d.x), ay = fabs(d.y), az = fabs(d.z);

@@ -139,21 +139,24 @@ static inline int lowest_bit(int bits) {
 static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
                              bool any_hit) {
   __global const BvhNode8* nodes = (__global const BvhNode8*)scene->nodes;
-  __global const TriBlock4* blocks = (__global const TriBlock4*)scene->tris;
   int stack_node[WP_BVH8_STACK_SIZE];
   float stack_t[WP_BVH8_STACK_SIZE];
   int sp = 0;
   int node = 0;
   bool found = false;
   hit->t = tmax;
+  /* Each axis's near plane among a node's six box arrays (lo_x, hi_x, lo_y, hi_y, lo_z, hi_z): the
+   * far one is that ^ 1. */
+  const int near_x = r->ix < 0.0f ? 1 : 0, near_y = r->iy < 0.0f ? 3 : 2,
+            near_z = r->iz < 0.0f ? 5 : 4;
   for (;;) {
     __global const BvhNode8* n = nodes + node;
     __global const float8* box = (__global const float8*)n;
     /* The slab test with each axis's near and far planes picked by the direction's sign (lo <= hi
      * in every box: bvh_check_wide), the same values as min and max of both planes' distances. */
-    const float8 tnx = (box[r->near_x] - r->ox) * r->ix, tfx = (box[r->near_x ^ 1] - r->ox) * r->ix;
-    const float8 tny = (box[r->near_y] - r->oy) * r->iy, tfy = (box[r->near_y ^ 1] - r->oy) * r->iy;
-    const float8 tnz = (box[r->near_z] - r->oz) * r->iz, tfz = (box[r->near_z ^ 1] - r->oz) * r->iz;
+    const float8 tnx = (box[near_x] - r->ox) * r->ix, tfx = (box[near_x ^ 1] - r->ox) * r->ix;
+    const float8 tny = (box[near_y] - r->oy) * r->iy, tfy = (box[near_y ^ 1] - r->oy) * r->iy;
+    const float8 tnz = (box[near_z] - r->oz) * r->iz, tfz = (box[near_z ^ 1] - r->oz) * r->iz;
     const float8 tnear = max8(max8(tnx, tny), max8(tnz, (float8)(r->tmin)));
     const float8 tfar = min8(min8(tfx, tfy), min8(tfz, (float8)(hit->t)));
     const int8 child = n->child;
@@ -167,7 +170,8 @@ static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tm
     for (int bits = leaves | inner; bits != 0; bits &= bits - 1) {
       const int c = cl[lowest_bit(bits)];
       if (c < 0) {
-        __global const char* p = (__global const char*)(blocks + (~c >> 2));
+        __global const char* p =
+            (__global const char*)((__global const TriBlock4*)scene->tris + (~c >> 2));
         bvh_prefetch(p);
         bvh_prefetch(p + 64);
         bvh_prefetch(p + 128);

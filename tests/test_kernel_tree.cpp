@@ -44,7 +44,7 @@ std::vector<std::string> path_fields() {
   std::vector<std::string> fields;
   for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
     if (std::string(f.name) != "shared/path_state.def") continue;
-    const std::regex field(R"(^WP_PATH_(?:AOV_|OPT_)?FIELD\((?:"[^"]*",\s*)?\w+,\s*(\w+),)");
+    const std::regex field(R"(^WP_PATH_(?:AOV_|OPT_|SURF_|ALIAS_)?FIELD\((?:"[^"]*",\s*)?\w+,\s*(\w+),)");
     std::istringstream lines(f.text);
     for (std::string line; std::getline(lines, line);) {
       std::smatch m;
@@ -54,7 +54,7 @@ std::vector<std::string> path_fields() {
   return fields;
 }
 
-// A field indexed by slot (`paths.info[slot]`, `p.hit [i]`): the raw access the accessors replace.
+// A field indexed by slot (`paths.hit[slot]`, `p.hit [i]`): the raw access the accessors replace.
 std::regex raw_access(const std::vector<std::string>& fields) {
   std::string alternatives;
   for (const auto& f : fields) alternatives += (alternatives.empty() ? "" : "|") + f;
@@ -63,10 +63,10 @@ std::regex raw_access(const std::vector<std::string>& fields) {
 
 TEST(KernelSources, PathStateIsReachedOnlyThroughItsAccessors) {
   const std::vector<std::string> fields = path_fields();
-  ASSERT_GE(fields.size(), 14u) << "path_state.def not found or not parsed";
+  ASSERT_GE(fields.size(), 20u) << "path_state.def not found or not parsed";
   const std::regex raw = raw_access(fields);
   // The pattern catches what it is meant to (else the test below could pass by matching nothing).
-  EXPECT_TRUE(std::regex_search(std::string("paths.info[slot].w = 0u;"), raw));
+  EXPECT_TRUE(std::regex_search(std::string("paths.hit[slot].w = 0u;"), raw));
   EXPECT_TRUE(std::regex_search(std::string("p . throughput [i].xyz"), raw));
   EXPECT_FALSE(
       std::regex_search(std::string("path_info(paths, slot); wp_prefetch(paths.hit + s)"), raw));
