@@ -44,7 +44,8 @@ std::vector<std::string> path_fields() {
   std::vector<std::string> fields;
   for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
     if (std::string(f.name) != "shared/path_state.def") continue;
-    const std::regex field(R"(^WP_PATH_(?:AOV_|OPT_|SURF_|ALIAS_)?FIELD\((?:"[^"]*",\s*)?\w+,\s*(\w+),)");
+    const std::regex field(
+        R"(^WP_PATH_(?:AOV_|OPT_|SURF_|ALIAS_)?FIELD\((?:"[^"]*",\s*)?\w+,\s*(\w+),)");
     std::istringstream lines(f.text);
     for (std::string line; std::getline(lines, line);) {
       std::smatch m;
