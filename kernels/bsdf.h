@@ -602,13 +602,20 @@ static inline void eval_layers(const Surface* s, float3 wo, float3 wi, float cos
 }
 #endif
 
+/* bsdf_eval is forced inline on PoCL's CPU devices (the builds with WP_PREFETCH): with two callers
+ * (NEE, bsdf_sample) clang kept it out of line in `shade`, a call per evaluation that took 13% of
+ * a Cornell box render. Elsewhere the compiler decides: Oclgrind cannot run what an always-inlined
+ * function returning a struct leaves behind (llvm.experimental.noalias.scope.decl, stage.h). */
+#if WP_PREFETCH
+#define WP_BSDF_EVAL_INLINE static inline __attribute__((always_inline))
+#else
+#define WP_BSDF_EVAL_INLINE static inline
+#endif
+
 #if !WP_FEATURE_GLOSSY
 
-/* Lambert: f = base / pi and the cosine-weighted pdf, for wi above both normals. bsdf_eval is
- * forced inline (both versions): with two callers (NEE, bsdf_sample) clang kept it out of line in
- * `shade` on PoCL, a call per evaluation that took 13% of a Cornell box render. */
-static inline __attribute__((always_inline)) BsdfEval bsdf_eval(const Surface* s, float3 wo,
-                                                                float3 wi) {
+/* Lambert: f = base / pi and the cosine-weighted pdf, for wi above both normals. */
+WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
   BsdfEval e = {(float3)(0.0f), 0.0f};
   const float cos_i = dot(s->ns, wi);
   if (!(dot(s->ns, wo) > 0.0f) || !(cos_i > 0.0f && dot(s->ng, wi) > 0.0f)) return e;
@@ -648,8 +655,7 @@ static inline float3 bsdf_pane_transmittance(const Surface* s, float3 d) {
 
 #else
 
-static inline __attribute__((always_inline)) BsdfEval bsdf_eval(const Surface* s, float3 wo,
-                                                                float3 wi) {
+WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
   BsdfEval e = {(float3)(0.0f), 0.0f};
   const float cos_i = dot(s->ns, wi), cos_o = dot(s->ns, wo);
   if (!(cos_o > 0.0f)) return e;
