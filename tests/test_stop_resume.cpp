@@ -111,6 +111,24 @@ TEST_F(StopResume, TimeLimitAlwaysRendersTheFirstPass) {
   EXPECT_EQ(json_number(r.out, "spp_requested"), 1000) << r.out;
 }
 
+// Pixel samples per second are spp x pixels / seconds, also where a pass (a wave) holds several
+// samples of each of the 384 pixels: then passes < spp, and counting passes as samples (as
+// wavepath once did) under-reports by spp / passes. The JSON prints %.6g: each figure within
+// 5e-6 of its value, so the product within 1.1e-5.
+TEST_F(StopResume, SamplesPerSecondCountsPixelSamples) {
+  // --wave-size and the passes 12 samples take: 2^18 slots (the default) hold all 12, 384 one.
+  for (const auto& [wave, passes] : std::vector<std::pair<std::string, int>>{
+           {"", 1}, {"--wave-size 384 ", 12}, {"--wave-size 1536 ", 3}}) {
+    const CliRun r = run(scene_args() + wave + "--spp 12 --json -q -o t.pfm");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json_number(r.out, "passes"), passes) << wave << r.out;
+    EXPECT_EQ(json_number(r.out, "samples_rendered"), 12) << r.out;
+    EXPECT_NEAR(json_number(r.out, "samples_per_second") * json_number(r.out, "seconds"),
+                12.0 * 24 * 16, 1.1e-5 * 12 * 24 * 16)
+        << wave << r.out;
+  }
+}
+
 // A 2 s limit on a render of 2^20 passes (about 20 minutes here): it stops at a pass boundary,
 // long before, with an image exactly that of its samples. The upper bound on its time is loose
 // (the limit plus 10 s, for a loaded machine; a pass takes milliseconds): it tells a stop from
@@ -239,6 +257,12 @@ TEST_F(StopResume, InterruptedRenderKeepsItsWorkAndResumesExactly) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(json_number(r.out, "passes"), 7) << r.out;
   EXPECT_EQ(json_number(r.out, "spp"), done + 7) << r.out;
+  // Throughput counts the samples this run rendered, not the resumed ones (%.6g: each printed
+  // figure within 5e-6 of its value, so the product within 1.1e-5).
+  EXPECT_EQ(json_number(r.out, "samples_rendered"), 7) << r.out;
+  EXPECT_NEAR(json_number(r.out, "samples_per_second") * json_number(r.out, "seconds"),
+              7.0 * 24 * 16, 1.1e-5 * 7 * 24 * 16)
+      << r.out;
   expect_same_as_render_of(done + 7, "res.pfm", "ck.wpfilm");
 }
 

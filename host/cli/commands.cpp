@@ -119,8 +119,8 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   // Rank 0's passes stand for the job's: the ranks render at about the same pace.
   Progress progress(!cli.quiet && ranks.root(), isatty(STDERR_FILENO), cli.progress_every,
                     double(settings.width) * settings.height, options.deadline);
-  options.progress = [&](int done, int total, double seconds, int passes) {
-    progress.update(done, total, seconds, passes);
+  options.progress = [&](int done, int total, double seconds, int rendered) {
+    progress.update(done, total, seconds, rendered);
   };
   if (!cli.checkpoint.empty()) {
     options.checkpoint_every = cli.checkpoint_every;
@@ -231,6 +231,7 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   if (ranks.size() > 1) {  // the report of every rank's samples
     result.report.render_seconds = all.render_seconds;
     result.report.rays = all.rays;
+    result.report.samples_rendered = result.film.info().samples();  // MPI: no resume
     result.report.nonfinite_samples = result.film.info().nonfinite_samples;
     result.report.device = result.film.info().device;
   }

@@ -22,9 +22,12 @@ class Progress {
         deadline_(deadline),
         next_line_(every) {}
 
-  void update(int done, int total, double seconds, int passes) {
+  // `done` of `total` samples in the film, `rendered` of them by this run (not resumed ones), in
+  // `seconds`.
+  void update(int done, int total, double seconds, int rendered) {
     if (!enabled_ || (!terminal_ && seconds < next_line_)) return;
-    const double rate = seconds > 0 ? passes / seconds : 0.0;  // passes per second
+    const double rate =
+        seconds > 0 ? rendered / seconds : 0.0;  // samples (of every pixel) per second
     double eta = rate > 0 ? (total - done) / rate : 0.0;
     if (deadline_)
       eta = std::min(

@@ -217,9 +217,11 @@ class PassScheduler {
       const std::uint32_t samples = next_pass_samples();
       wf_.render_pass(next_, samples);
       next_ += samples;
+      r_.samples_rendered += samples;
       if (r_.passes++ == 0) r_.first_pass_seconds = since(start);
       if (options_.progress)
-        options_.progress(int(next_ - begin_), settings_.spp, since(passes_start_), r_.passes);
+        options_.progress(int(next_ - begin_), settings_.spp, since(passes_start_),
+                          int(r_.samples_rendered));
       if (options_.interrupted && options_.interrupted()) {
         r_.stop = StopReason::kInterrupted;
         break;

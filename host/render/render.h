@@ -55,13 +55,18 @@ struct RenderReport {
   // passes stopped early (`stop`).
   std::uint32_t sample_end = 0;
   int passes = 0;  // sample passes rendered by this call (resumed ones not)
+  // Samples of every pixel rendered by this call (resumed ones not; all ranks' under MPI). A pass
+  // holds several when the image is smaller than a wave.
+  std::uint32_t samples_rendered = 0;
   StopReason stop = StopReason::kComplete;
   double relative_error = 0;  // the film's estimated relative error at the end (film.h)
   int checkpoints = 0;        // RenderOptions::checkpoint calls
   int ranks =
       1;  // processes whose samples this is (MPI, host/cli/distributed.h); set by the caller
+  // Pixel samples per second of the passes: width x height x samples_rendered / render_seconds.
   double samples_per_second(const RenderSettings& s) const {
-    return render_seconds > 0 ? double(s.width) * s.height * passes / render_seconds : 0.0;
+    return render_seconds > 0 ? double(s.width) * s.height * samples_rendered / render_seconds
+                              : 0.0;
   }
 };
 
@@ -69,7 +74,7 @@ struct RenderOptions {
   bvh::BuildOptions bvh;   // the width is set per device (bvh_width)
   bool bvh_cache = false;  // look the BVH up in, and store it to, cache_dir() (host/util/files.h)
   // Called after each sample pass with (samples in the film, samples requested, seconds since
-  // the start of the passes, passes rendered by this call).
+  // the start of the passes, samples rendered by this call: the film's less any resumed).
   std::function<void(int, int, double, int)> progress;
 
   // Continue this film (a checkpoint) instead of starting from zero: the same render key and

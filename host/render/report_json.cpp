@@ -64,7 +64,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"stop\":" << json_string(stop_reason_name(r.stop)) << ",\"passes\":" << r.passes
     << ",\"relative_error\":" << num(r.relative_error) << ",\"checkpoints\":" << r.checkpoints
     << ",\"width\":" << s.width << ",\"height\":" << s.height
-    << ",\"seconds\":" << num(r.render_seconds)
+    << ",\"seconds\":" << num(r.render_seconds) << ",\"samples_rendered\":" << r.samples_rendered
     << ",\"samples_per_second\":" << num(r.samples_per_second(s))
     << ",\"device\":" << json_string(r.device) << ",\"triangles\":" << r.triangles
     << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)
