@@ -106,6 +106,13 @@
 
 /* AOVs: 1 records each sample's albedo, normal and depth (path_state.def, shade_surface.cl)
  * and adds them to the film (shared/film.h); 0 (the default) compiles none of it. */
+/* A thin-lens camera (camera.h): programs of pinhole cameras carry no lens code, so they run the
+ * same arithmetic as before there was a lens (LLVM's code for the pinhole ray differed in its last
+ * bits once the lens branch was beside it). */
+#ifndef WP_THIN_LENS
+#define WP_THIN_LENS 0
+#endif
+
 #ifndef WP_AOV
 #define WP_AOV 0
 #endif

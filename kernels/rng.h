@@ -20,12 +20,12 @@
  * The light and BSDF pairs are chained instead, two bounces to one order (rng_pair_source): the
  * BSDF order of an even bounce carries eight dimensions, that bounce's direction, the next
  * bounce's direction and the light points of the next two bounces, and the light point at bounce 0
- * takes dimensions 2, 3 of the pixel jitter's order. Each light point is then stratified together
- * with the direction of the ray that found its surface, and each odd bounce's direction with the
- * one before it, at the cost of pairs that alone stratify a little less (dimensions 2-7 have
- * t-values up to 3 where dimensions 0, 1 have 0: each elementary interval of area 2^(t-k) holds
- * 2^t of 2^k samples). Less error for the same samples than the padded pattern, measured in
- * docs/light-transport.md, "Chained sample pairs".
+ * takes dimensions 2, 3 of the pixel jitter's order (and a thin lens's point 4, 5). Each light
+ * point is then stratified together with the direction of the ray that found its surface, and each
+ * odd bounce's direction with the one before it, at the cost of pairs that alone stratify a little
+ * less (dimensions 2-7 have t-values up to 3 where dimensions 0, 1 have 0: each elementary interval
+ * of area 2^(t-k) holds 2^t of 2^k samples). Less error for the same samples than the padded
+ * pattern, measured in docs/light-transport.md, "Chained sample pairs".
  *
  * Sobol, padded (WP_SAMPLER_SOBOL_PADDED): the same points, every pair in an order of its own
  * (the default pattern until 2026-11-25).
@@ -53,6 +53,8 @@
 #define WP_DIM_ROULETTE 8u
 #define WP_DIM_ALPHA_CLOSEST 9u /* stochastic alpha of the closest-hit ray (a key, see alpha.h) */
 #define WP_DIM_ALPHA_SHADOW 10u /* ... and of the shadow ray */
+#define WP_DIM_LENS_U 11u       /* the thin lens's (u, v), bounce 0 only (camera.h) */
+#define WP_DIM_LENS_V 12u
 #define WP_DIMS_PER_BOUNCE 16u
 
 /* The integer functions below are defined for uint and uint8 (suffix 8), the hash and the Sobol'
@@ -339,16 +341,19 @@ typedef struct PairSource {
  * dimensions, so the numbers of successive scattering events are stratified together instead of
  * paired at random. The BSDF order of an even bounce k carries the BSDF direction at k (dimensions
  * 0, 1), the BSDF direction at k + 1 (2, 3), the light point at k + 1 (4, 5) and the light point
- * at k + 2 (6, 7); the light point at bounce 0 takes dimensions 2, 3 of the pixel jitter's order.
- * So each light point shares an order with the direction of the ray that found its surface, and
- * each odd bounce's direction with the even one's before it. A group k bounces back is the
- * current one less k * WP_DIMS_PER_BOUNCE, through unsigned wrap-around. Padded: every pair in an
- * order of its own. */
+ * at k + 2 (6, 7); the light point at bounce 0 takes dimensions 2, 3 of the pixel jitter's order,
+ * and the lens point (a camera with an aperture) dimensions 4, 5, so the pixel, lens and first
+ * light points are stratified together. So each light point shares an order with the direction of
+ * the ray that found its surface, and each odd bounce's direction with the even one's before it. A
+ * group k bounces back is the current one less k * WP_DIMS_PER_BOUNCE, through unsigned
+ * wrap-around. Padded: every pair in an order of its own. */
 static inline PairSource rng_pair_source(Rng r, uint dim) {
   PairSource s = {dim, 0u};
 #if WP_CHAIN_PAIRS
   const bool odd = (r.bounce & 1u) != 0u;
-  if (dim == WP_DIM_LIGHT_U) {
+  if (dim == WP_DIM_LENS_U) {
+    s.group = WP_DIM_PIXEL_X, s.pair = 2u;
+  } else if (dim == WP_DIM_LIGHT_U) {
     if (r.bounce == 0u) {
       s.group = WP_DIM_PIXEL_X, s.pair = 1u;
     } else {

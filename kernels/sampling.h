@@ -34,20 +34,24 @@ static inline float2 cos_sin_turn(float u) {
   return (float2)(c, s);
 }
 
-/* Cosine-weighted hemisphere (concentric disk mapping, then lifted): pdf = cos(theta) / pi. The
- * disk angle is (pi/4) q or pi/2 - (pi/4) q with |q| <= 1, so cos_sin_quarter serves both. */
-static inline float3 sample_cosine_hemisphere(float2 u) {
+/* Uniform on the unit disk (Shirley and Chiu's concentric mapping of the square, area-preserving):
+ * pdf = 1 / pi. The disk angle is (pi/4) q or pi/2 - (pi/4) q with |q| <= 1, so cos_sin_quarter
+ * serves both. */
+static inline float2 sample_concentric_disk(float2 u) {
   const float2 s = 2.0f * u - 1.0f;
-  if (s.x == 0.0f && s.y == 0.0f) return (float3)(0.0f, 0.0f, 1.0f);
-  float x, y;
+  if (s.x == 0.0f && s.y == 0.0f) return (float2)(0.0f);
   if (fabs(s.x) > fabs(s.y)) {
     const float2 cs = cos_sin_quarter((WP_PI / 4.0f) * (s.y / s.x));
-    x = s.x * cs.x, y = s.x * cs.y;
-  } else { /* phi = pi/2 - t: cos phi = sin t, sin phi = cos t */
-    const float2 cs = cos_sin_quarter((WP_PI / 4.0f) * (s.x / s.y));
-    x = s.y * cs.y, y = s.y * cs.x;
-  }
-  return (float3)(x, y, sqrt(fmax(0.0f, 1.0f - x * x - y * y)));
+    return (float2)(s.x * cs.x, s.x * cs.y);
+  } /* phi = pi/2 - t: cos phi = sin t, sin phi = cos t */
+  const float2 cs = cos_sin_quarter((WP_PI / 4.0f) * (s.x / s.y));
+  return (float2)(s.y * cs.y, s.y * cs.x);
+}
+
+/* Cosine-weighted hemisphere (the concentric disk, lifted): pdf = cos(theta) / pi. */
+static inline float3 sample_cosine_hemisphere(float2 u) {
+  const float2 p = sample_concentric_disk(u);
+  return (float3)(p.x, p.y, sqrt(fmax(0.0f, 1.0f - p.x * p.x - p.y * p.y)));
 }
 
 static inline float cosine_hemisphere_pdf(float cos_theta) {

@@ -54,8 +54,10 @@ class Cli : public wp::test::FolderTest {
 TEST_F(Cli, HelpDescribesRenderOptions) {
   const CliRun r = run("render --help");
   EXPECT_EQ(r.status, 0);
-  for (const char* opt : {"--width", "--height", "--spp", "--camera", "--env-color", "--max-depth",
-                          "--seed", "--device", "--json", "--output"})
+  for (const char* opt :
+       {"--width", "--height", "--spp", "--camera", "--env-color", "--max-depth", "--seed",
+        "--device", "--json", "--output", "--look-from", "--look-at", "--up", "--orbit", "--fov",
+        "--aperture", "--focus-distance", "--focus-on"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
 }
 
@@ -88,6 +90,13 @@ TEST_F(Cli, BadOptionValues) {
   expect_error(run("render '" + cornell() + "' -o out.jpg"), "out.jpg");
   expect_error(run("render '" + cornell() + "' -o missing_dir/out.exr"), "missing_dir");
   expect_error(run("render '" + cornell() + "' --features some"), "features");
+  // The view (host/scene/view.h; its checks one by one in test_view): refused before rendering.
+  expect_error(run("render '" + cornell() + "' --look-from 0,1,5"), "--look-at go together");
+  expect_error(run("render '" + cornell() + "' --orbit 10"), "--orbit");
+  expect_error(run("render '" + cornell() + "' --camera 0 --orbit 0,90"), "--camera and");
+  expect_error(run("render '" + cornell() + "' --fov 0"), "--fov");
+  expect_error(run("render '" + cornell() + "' --orbit 0,90 --aperture 0.1 --focus-on 0,0,50"),
+               "not in front of the camera");
 }
 
 // CLI11's own exit codes (104, 106, ...) are not the documented 1; help and version still exit 0.

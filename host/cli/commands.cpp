@@ -17,6 +17,7 @@
 #include "host/render/render.h"
 #include "host/render/report_json.h"
 #include "host/scene/gltf_loader.h"
+#include "host/scene/view.h"
 #include "host/util/error.h"
 
 namespace wp::cli {
@@ -97,10 +98,9 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   std::optional<wp::Film> resume;
   if (!cli.resume.empty()) resume = wp::Film::read(cli.resume);
   const wp::Scene scene = wp::load_gltf(cli.scene, wp::LoadOptions{cli.variant});
-  // Known now, not only once the kernels are built and the BVH is made.
-  if (mine.camera >= 0 && static_cast<std::size_t>(mine.camera) >= scene.cameras.size())
-    throw wp::Error("--camera " + std::to_string(mine.camera) + ": the scene has " +
-                    std::to_string(scene.cameras.size()) + " camera(s)");
+  // A camera the scene cannot give (an index past its cameras, a lens on an orthographic one, a
+  // focus behind it) is known now, not only once the kernels are built and the BVH is made.
+  (void)wp::choose_camera(scene, mine.camera, mine.view, float(mine.width) / float(mine.height));
   part.load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!cli.quiet && ranks.root())

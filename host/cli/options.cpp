@@ -81,6 +81,22 @@ void add_png_options(CLI::App* app, CliOptions& cli) {
   app->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
 }
 
+// The view options as given (checked by wp::validate, view.h).
+wp::View view_options(const CLI::App& render, const CliOptions& cli) {
+  wp::View v;
+  const auto vec = [](const std::vector<float>& x) { return glm::vec3(x[0], x[1], x[2]); };
+  if (!cli.look_from.empty()) v.look_from = vec(cli.look_from);
+  if (!cli.look_at.empty()) v.look_at = vec(cli.look_at);
+  if (!cli.up.empty()) v.up = vec(cli.up);
+  if (!cli.orbit.empty())
+    v.orbit = glm::vec3(cli.orbit[0], cli.orbit[1], cli.orbit.size() > 2 ? cli.orbit[2] : 0.0f);
+  if (!cli.focus_on.empty()) v.focus_on = vec(cli.focus_on);
+  if (render.count("--fov")) v.fov = cli.fov;
+  if (render.count("--focus-distance")) v.focus_distance = cli.focus_distance;
+  v.aperture = cli.aperture;
+  return v;
+}
+
 // Ranges CLI11 cannot express and wp::validate (render.h) does not cover: these are the command
 // line's own, so they are checked here, before anything is loaded.
 void check_options(const CLI::App& render, const CliOptions& cli,
@@ -157,10 +173,47 @@ void add_output_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
       ->capture_default_str();
 }
 
-// The camera, the materials and the light around the scene.
-void add_scene_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& settings) {
+// The camera: the file's, or one placed here, and its lens.
+void add_camera_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& settings) {
   app->add_option("--camera", settings.camera,
-                  "Camera index in node order [default: the first, else one framing the scene]");
+                  "Camera index in node order (`wavepath info` lists them) [default: the first, "
+                  "else one framing the scene: its bounding sphere seen from +Z, 15 degrees "
+                  "above]");
+  const auto point = [&](const char* name, std::vector<float>& into, const char* help) {
+    app->add_option(name, into, help)->delimiter(',')->expected(3)->type_name("X,Y,Z");
+  };
+  point("--look-from", cli.look_from,
+        "Place a perspective camera at this point (scene units, world space, +Y up) looking at "
+        "--look-at");
+  point("--look-at", cli.look_at, "The point the --look-from camera looks at (the image centre)");
+  point("--up", cli.up,
+        "With --look-from or --orbit: the direction that is up in the image (projected onto "
+        "it) [default: 0,1,0; --orbit: +Y, and through the poles its limit]");
+  app->add_option("--orbit", cli.orbit,
+                  "Place a perspective camera on a sphere about the centre of the scene's "
+                  "bounds (the Khronos Render Fidelity convention): position = centre + "
+                  "DISTANCE (sin PHI sin THETA, cos PHI, sin PHI cos THETA), degrees (THETA "
+                  "azimuth from +Z towards +X, PHI from +Y; 0,90 looks from +Z); DISTANCE 0 or "
+                  "left out: the bounding sphere just fits the view")
+      ->delimiter(',')
+      ->expected(2, 3)
+      ->type_name("THETA,PHI[,DISTANCE]");
+  app->add_option("--fov", cli.fov,
+                  "Vertical field of view in degrees, for the camera used (a perspective one) "
+                  "[default: the file camera's; 45 for --look-from, --orbit and the framing "
+                  "camera, which then moves to fit the scene]");
+  app->add_option("--aperture", cli.aperture,
+                  "Thin lens: the lens radius in scene units (0: a pinhole, everything sharp); "
+                  "points on the plane of focus stay sharp, others blur into discs");
+  app->add_option("--focus-distance", cli.focus_distance,
+                  "With --aperture: the distance of the plane of focus along the view direction "
+                  "[default: the --look-at point's, the --orbit centre's, else the scene "
+                  "centre's]");
+  point("--focus-on", cli.focus_on, "With --aperture: focus on the plane through this point");
+}
+
+// The materials and the light around the scene.
+void add_scene_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& settings) {
   app->add_option("--variant", cli.variant,
                   "Material variant (KHR_materials_variants) by name: each primitive gets its "
                   "material for that variant, or its own where it has none; an unknown name "
@@ -282,6 +335,7 @@ void check_exposure(const CliOptions& cli) {
 
 void add_render_options(CLI::App* render, CliOptions& cli, wp::RenderSettings& settings) {
   add_output_options(render, cli, settings);
+  add_camera_options(render, cli, settings);
   add_scene_options(render, cli, settings);
   add_transport_options(render, cli, settings);
   add_engine_options(render, cli, settings);
@@ -323,6 +377,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
         "(the ranks would have to agree where each stops); render sample ranges (--samples) "
         "and merge them instead");
   if (!cli.checkpoint.empty()) check_outputs({cli.checkpoint});
+  settings.view = view_options(render, cli);
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
   settings.aov = !cli.aovs.empty();

@@ -16,6 +16,9 @@ namespace wp::cli {
 struct CliOptions {
   std::string scene;
   std::string variant;  // --variant: KHR_materials_variants name ("": the file's own materials)
+  // The view (host/scene/view.h), as given: vectors of 3 (--orbit 2 or 3) numbers.
+  std::vector<float> look_from, look_at, up, orbit, focus_on;
+  float fov = 0.0f, aperture = 0.0f, focus_distance = 0.0f;
   std::vector<std::string> parts;  // merge: the .wpfilm files
   std::vector<std::string> outputs;
   std::string samples;  // --samples A:B

@@ -158,6 +158,7 @@ dev::Camera device_camera(const Camera& c, int width, int height) {
   d.forward = f4(forward);
   d.right = f4(right * half_w);
   d.up = f4(up * half_h);
+  d.lens = {c.lens_radius, c.focus_distance, 0.0f, 0.0f};
   d.meta = {c.type == CameraType::kPerspective ? WP_CAMERA_PERSPECTIVE : WP_CAMERA_ORTHOGRAPHIC, 0u,
             0u, 0u};
   return d;

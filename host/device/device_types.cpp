@@ -21,11 +21,11 @@ static_assert(sizeof(TextureRef) == 48);
 static_assert(sizeof(TextureImage) == 16);
 static_assert(sizeof(Light) == 80);
 static_assert(sizeof(LightAlias) == 16);
-static_assert(sizeof(Camera) == 80);
-static_assert(offsetof(SceneDesc, background) == 80);
-static_assert(offsetof(SceneDesc, env_params) == 96);
-static_assert(offsetof(SceneDesc, bvh_nodes) == 112);
-static_assert(sizeof(SceneDesc) == 224);
+static_assert(sizeof(Camera) == 96);
+static_assert(offsetof(SceneDesc, background) == 96);
+static_assert(offsetof(SceneDesc, env_params) == 112);
+static_assert(offsetof(SceneDesc, bvh_nodes) == 128);
+static_assert(sizeof(SceneDesc) == 240);
 static_assert(sizeof(Launch) == 64);
 static_assert(sizeof(PathLayout) % 4 == 0);
 

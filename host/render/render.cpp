@@ -41,6 +41,7 @@ void validate(const RenderSettings& s) {
   for (int i = 0; i < 3; ++i)
     check(std::isfinite(s.background[i]) && s.background[i] >= 0.0f,
           "--env-color must be three finite, non-negative numbers");
+  check_view(s.view, s.camera >= 0);
 }
 
 std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_width,
@@ -69,7 +70,8 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
                                        : "bsdf")
     << ";mis_heuristic=" << (s.mis_heuristic == MisHeuristic::kPower ? "power" : "balance")
     << ";light_select=" << (s.light_select == LightSelect::kPower ? "power" : "uniform")
-    << ";sampler=" << sampler_name(s.sampler) << ";camera=" << s.camera
+    << ";sampler=" << sampler_name(s.sampler) << ";camera=" << s.camera << ";view={"
+    << view_text(s.view) << "}"
     << ";features=" << (s.all_features ? "all" : "scene") << ";bvh_width=" << bvh_width
     << ";spatial_splits=" << (spatial_splits ? 1 : 0) << ";aov=" << (s.aov ? 1 : 0)
     << ";kernels=" << hex64(kernel_digest);

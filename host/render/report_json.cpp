@@ -30,6 +30,7 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
           {"wavepath:rr_threshold", num(s.rr_threshold)},
           {"wavepath:seed", std::to_string(s.seed)},
           {"wavepath:camera", std::to_string(s.camera)},
+          {"wavepath:view", view_text(s.view)},
           {"wavepath:background",
            num(s.background.x) + "," + num(s.background.y) + "," + num(s.background.z)},
           {"wavepath:strategy", s.strategy == Strategy::kMis   ? "mis"

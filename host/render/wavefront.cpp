@@ -7,7 +7,7 @@
 #include "host/device/device_scene.h"
 #include "host/util/error.h"
 #include "host/util/fnv1a.h"
-#include "host/scene/gltf_loader.h"
+#include "host/scene/view.h"
 #include "host/device/kernel_sources.h"
 #include "host/render/pipeline.h"
 
@@ -42,6 +42,7 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
                                          : s.sampler == Sampler::kSobol     ? "1"
                                                                             : "2");
   if (s.aov) o += " -D WP_AOV=1";
+  if (s.view.aperture > 0.0f) o += " -D WP_THIN_LENS=1";
   return o;
 }
 
@@ -53,14 +54,7 @@ std::string program_source() {
 
 const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
   const float aspect = static_cast<float>(s.width) / static_cast<float>(s.height);
-  if (s.camera >= 0) {
-    if (static_cast<std::size_t>(s.camera) >= scene.cameras.size())
-      throw Error("--camera " + std::to_string(s.camera) + ": the scene has " +
-                  std::to_string(scene.cameras.size()) + " camera(s)");
-    return device_camera(scene.cameras[s.camera], s.width, s.height);
-  }
-  if (!scene.cameras.empty()) return device_camera(scene.cameras.front(), s.width, s.height);
-  return device_camera(framing_camera(scene, aspect), s.width, s.height);
+  return device_camera(choose_camera(scene, s.camera, s.view, aspect), s.width, s.height);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "host/lights/light_table.h"
 #include "host/render/path_state.h"
 #include "host/scene/scene.h"
+#include "host/scene/view.h"
 #include "host/device/scene_buffers.h"
 #include "host/device/scene_features.h"
 #include "host/render/pipeline.h"
@@ -62,6 +63,7 @@ struct RenderSettings {
   LightSelect light_select = LightSelect::kPower;
   Sampler sampler = Sampler::kSobol;
   int camera = -1;            // index into Scene::cameras; -1: the first, or a framing camera
+  View view;                  // a camera placed from the command line, field of view, lens (view.h)
   bool all_features = false;  // build every kernel feature regardless of the scene
   // Path slots per wave; 0: min(pixels, 2^20), or for an image of fewer than kMultiSamplePaths
   // pixels, as many whole samples of it as fit in kMultiSamplePaths. A size above the pixel count

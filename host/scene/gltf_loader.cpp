@@ -18,6 +18,7 @@
 #include <glm/trigonometric.hpp>
 #include <tiny_gltf.h>
 
+#include "host/scene/view.h"
 #include "host/util/error.h"
 #include "host/util/fnv1a.h"
 #include "host/scene/gltf_material.h"
@@ -504,10 +505,7 @@ Camera framing_camera(const Scene& scene, float aspect) {
   c.name = "framing";
   c.type = CameraType::kPerspective;
   c.yfov = glm::radians(45.0f);
-  // The bounding sphere fits when the tighter half-angle of the view subtends its radius.
-  const float half_v = 0.5f * c.yfov;
-  const float half = std::min(half_v, std::atan(std::tan(half_v) * aspect));
-  const float distance = radius / std::sin(half);
+  const float distance = fit_distance(radius, c.yfov, aspect);
   const float elevation = glm::radians(15.0f);                           // "slightly from above"
   const glm::vec3 back(0.0f, std::sin(elevation), std::cos(elevation));  // towards the camera
   c.position =

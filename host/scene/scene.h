@@ -132,6 +132,11 @@ struct Camera {
   float xmag = 1.0f;                     // orthographic: half width of the view, scene units
   float ymag = 1.0f;                     // orthographic: half height
   float znear = 0.0f;  // distance to the near plane along forward; nothing closer is seen
+  // Thin lens (perspective only; view.h): rays start on a disc of this radius about `position`,
+  // perpendicular to forward, and meet where the pinhole ray through the same image point meets
+  // the plane focus_distance along forward. 0: a pinhole.
+  float lens_radius = 0.0f;
+  float focus_distance = 1.0f;
 };
 
 struct Scene {

@@ -11,13 +11,14 @@
 WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, uint slot) {
   const uint pixel = path_pixel(launch, slot);
   const uint px = pixel % launch.width, py = pixel / launch.width;
-  const float2 jitter =
-      rng_get2(rng_make(pixel, path_sample(launch, slot), launch.seed, 0u), WP_DIM_PIXEL_X);
+  const Rng rng = rng_make(pixel, path_sample(launch, slot), launch.seed, 0u);
+  const float2 jitter = rng_get2(rng, WP_DIM_PIXEL_X);
   const float2 ndc = (float2)(2.0f * ((float)px + jitter.x) / (float)launch.width - 1.0f,
                               1.0f - 2.0f * ((float)py + jitter.y) / (float)launch.height);
+  const float2 lens = camera_has_lens(camera) ? rng_get2(rng, WP_DIM_LENS_U) : (float2)(0.5f);
   float3 o, d;
   float tmin;
-  camera_ray(camera, ndc, &o, &d, &tmin);
+  camera_ray(camera, ndc, lens, &o, &d, &tmin);
   path_store_ray_o(paths, slot, o, tmin);
   path_store_ray_d(paths, slot, d, 0.0f);
   /* A camera ray: no BSDF sample to weigh against (pdf 0). */

@@ -125,6 +125,7 @@ typedef struct Camera {
   float4 forward;  /* xyz: unit view direction */
   float4 right;    /* xyz: image +x at the edge of the image (NDC x = 1), see camera.h */
   float4 up;       /* xyz: image +y at the edge of the image (NDC y = 1) */
+  float4 lens;     /* x: thin-lens radius (0: a pinhole); y: focus distance along forward */
   uint4 meta;      /* x: WP_CAMERA_* type */
 } Camera;
 
