@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <stb_image.h>
 
 #include "host/film/image_io.h"
 #include "tests/cli_run.h"
@@ -249,6 +250,36 @@ TEST_F(Cli, EmptySceneRendersTheBackground) {
   for (std::size_t i = 0; i < img.rgb.size(); ++i)
     ASSERT_EQ(img.rgb[i], background[i % 3]) << "value " << i;
   EXPECT_NE(r.out.find("\"triangles\":0"), std::string::npos) << r.out;
+}
+
+// --tonemap and --exposure, for render and merge alike: the PNG holds png_encode (tonemap.h, tested
+// in test_tonemap) of the linear pixel, for every tonemap. An empty scene gives a uniform image.
+TEST_F(Cli, PngTonemaps) {
+  std::ofstream(dir_ / "scene.gltf")
+      << R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})";
+  const wp::Rgb background = {0.25f, 0.5f, 1.0f};
+  const std::string common = " --exposure 1.5 --tonemap ";
+  ASSERT_EQ(run("render scene.gltf --width 4 --height 2 --spp 1 -o bg.wpfilm -o render.png "
+                "--env-color 0.25,0.5,1 -q" +
+                common + "agx")
+                .status,
+            0);
+  for (const std::string& name : wp::tonemap_names()) {
+    SCOPED_TRACE(name);
+    const std::string png = name == "agx" ? "render.png" : name + ".png";
+    if (name != "agx") {
+      const CliRun r = run("merge bg.wpfilm -o " + png + " -q" + common + name);
+      ASSERT_EQ(r.status, 0) << r.err;
+    }
+    int w = 0, h = 0, n = 0;
+    unsigned char* pixels = stbi_load((dir_ / png).string().c_str(), &w, &h, &n, 3);
+    ASSERT_NE(pixels, nullptr);
+    const std::vector<unsigned char> got(pixels, pixels + 3 * w * h);
+    stbi_image_free(pixels);
+    ASSERT_EQ(w * h, 8);
+    const auto expected = wp::png_encode(background, {1.5f, wp::tonemap_from_name(name)});
+    for (std::size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], expected[i % 3]) << i;
+  }
 }
 
 TEST_F(Cli, RendersBothImagesWithSettingsAndJson) {

@@ -54,7 +54,7 @@ void write_outputs(const CliOptions& cli, const wp::Film& film,
                    const std::map<std::string, std::string>& exr_attributes) {
   wp::PngOptions png;
   png.exposure = cli.exposure;
-  png.tonemap = cli.tonemap == "clamp" ? wp::Tonemap::kClamp : wp::Tonemap::kAces;
+  png.tonemap = wp::tonemap_from_name(cli.tonemap);
   std::vector<std::string> images;
   for (const auto& o : cli.outputs)
     if (!is_film(o)) images.push_back(o);

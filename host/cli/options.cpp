@@ -75,8 +75,11 @@ void apply_samples(const CLI::App& render, const CliOptions& cli, wp::RenderSett
 
 // The PNG output's options, the same for render and merge.
 void add_png_options(CLI::App* app, CliOptions& cli) {
-  app->add_option("--tonemap", cli.tonemap, "PNG tonemap: aces or clamp")
-      ->check(CLI::IsMember({"aces", "clamp"}))
+  app->add_option("--tonemap", cli.tonemap,
+                  "PNG tonemap: aces (Narkowicz's per-channel ACES fit), agx (three.js's AgX: "
+                  "Blender 4's AgX base matrices with a polynomial sigmoid), "
+                  "pbr-neutral (Khronos PBR Neutral, KhronosGroup/ToneMapping), clamp (none)")
+      ->check(CLI::IsMember(wp::tonemap_names()))
       ->capture_default_str();
   app->add_option("--exposure", cli.exposure, "PNG exposure in stops")->capture_default_str();
 }

@@ -68,17 +68,13 @@ void write_exr(const std::string& path, const ImageRgb& img,
   file.writePixels(img.height);
 }
 
-float tonemap(float x, Tonemap t) {
-  if (t == Tonemap::kAces) {  // a rational fit of the ACES filmic curve (Narkowicz 2015)
-    x = std::max(x, 0.0f);
-    return (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
-  }
-  return x;
-}
-
 void write_png(const std::string& path, const ImageRgb& img, const PngOptions& png) {
   std::vector<unsigned char> bytes(img.rgb.size());
-  for (std::size_t i = 0; i < img.rgb.size(); ++i) bytes[i] = png_encode(img.rgb[i], png);
+  for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
+    const std::array<unsigned char, 3> code =
+        png_encode({img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]}, png);
+    std::copy(code.begin(), code.end(), bytes.begin() + std::ptrdiff_t(i));
+  }
   if (!stbi_write_png(path.c_str(), img.width, img.height, 3, bytes.data(), img.width * 3))
     throw Error("cannot write " + path);
 }
@@ -175,14 +171,6 @@ class BlockSignals {
 };
 
 }  // namespace
-
-unsigned char png_encode(float linear, const PngOptions& png) {
-  float x = tonemap(linear * std::exp2(png.exposure), png.tonemap);
-  if (!(x > 0.0f)) x = 0.0f;  // also NaN
-  x = std::min(x, 1.0f);
-  const float s = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
-  return static_cast<unsigned char>(std::lround(s * 255.0f));
-}
 
 std::vector<OutputFile> image_files(const std::vector<std::string>& paths, const ImageRgb& image,
                                     const std::map<std::string, std::string>& exr_attributes,

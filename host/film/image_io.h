@@ -10,18 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "host/film/tonemap.h"
+
 namespace wp {
 
 struct ImageRgb {
   int width = 0, height = 0;
   std::vector<float> rgb;  // linear, row by row from the top, 3 floats per pixel
-};
-
-enum class Tonemap { kClamp, kAces };
-
-struct PngOptions {
-  float exposure = 0.0f;  // stops: the image is scaled by 2^exposure before tonemapping
-  Tonemap tonemap = Tonemap::kAces;
 };
 
 // The file name's extension, lower case, with its dot (".exr"), or "".
@@ -71,8 +66,5 @@ void write_images(const std::vector<std::string>& paths, const ImageRgb& image,
 ImageRgb read_exr(const std::string& path, const std::string& layer = "");
 // Reads the string attributes of an OpenEXR header.
 std::map<std::string, std::string> read_exr_attributes(const std::string& path);
-
-// The 8-bit sRGB value PNG output stores for a linear value (after exposure and tonemap).
-unsigned char png_encode(float linear, const PngOptions& png);
 
 }  // namespace wp
