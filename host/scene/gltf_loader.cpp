@@ -20,6 +20,7 @@
 
 #include "host/util/error.h"
 #include "host/util/fnv1a.h"
+#include "host/scene/gltf_extensions.h"
 #include "host/scene/gltf_material.h"
 #include "host/scene/gltf_nodes.h"
 #include "host/scene/gltf_primitive.h"
@@ -27,16 +28,6 @@
 
 namespace wp {
 namespace {
-
-const std::set<std::string> kSupportedExtensions = {
-    "KHR_lights_punctual",        "KHR_materials_anisotropy",
-    "KHR_materials_clearcoat",    "KHR_materials_diffuse_transmission",
-    "KHR_materials_dispersion",   "KHR_materials_emissive_strength",
-    "KHR_materials_ior",          "KHR_materials_iridescence",
-    "KHR_materials_sheen",        "KHR_materials_specular",
-    "KHR_materials_transmission", "KHR_materials_unlit",
-    "KHR_materials_variants",     "KHR_materials_volume",
-    "KHR_mesh_quantization",      "KHR_texture_transform"};
 
 constexpr const char* kVariants = "KHR_materials_variants";
 
@@ -180,18 +171,23 @@ tinygltf::Model parse(const std::string& path, std::vector<std::string>* warning
   return model;
 }
 
-// Errors for required extensions wavepath lacks; a warning for each other unsupported one.
+// The file's extensions as the table of gltf_extensions.h has them: refused ones (required, not
+// supported) are an error naming them; a warning for each ignored one, saying what that means.
 void check_extensions(const tinygltf::Model& model, const std::string& path,
                       std::vector<std::string>* warnings) {
-  std::string missing;
-  for (const std::string& name : model.extensionsRequired)
-    if (!kSupportedExtensions.count(name)) missing += (missing.empty() ? "" : ", ") + name;
-  if (!missing.empty())
-    throw Error(path + ": requires unsupported extension" +
-                (missing.find(',') != std::string::npos ? "s " : " ") + missing);
-  for (const std::string& name : model.extensionsUsed)
-    if (!kSupportedExtensions.count(name))
-      warnings->push_back(path + ": ignoring unsupported extension " + name);
+  std::vector<ExtensionUse> uses = extension_uses(model.extensionsUsed, model.extensionsRequired);
+  std::string refused;
+  for (const ExtensionUse& use : uses)
+    if (use.support == ExtensionSupport::kRefused)
+      refused += (refused.empty() ? "" : ", ") + use.name;
+  if (!refused.empty())
+    throw RefusedExtensions(path + ": requires unsupported extension" +
+                                (refused.find(',') != std::string::npos ? "s " : " ") + refused,
+                            std::move(uses));
+  for (const ExtensionUse& use : uses)
+    if (use.support == ExtensionSupport::kIgnored)
+      warnings->push_back(path + ": ignoring unsupported extension " + use.name + " (" + use.note +
+                          ")");
 }
 
 // A name from the file for a one-line message: control characters become '?'.
