@@ -81,6 +81,7 @@ TEST(GltfExtensions, LoaderFollowsTheTable) {
                 std::string::npos)
           << used.warnings[0];
     }
+    EXPECT_EQ(used.gltf.extensions_used, std::vector<std::string>{name});
 
     g.top += ",\"extensionsRequired\":[\"" + name + "\"]";
     const std::string required = g.write("required.gltf");
