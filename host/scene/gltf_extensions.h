@@ -1,5 +1,5 @@
 // wavepath's glTF extension support, in one table: the loader refuses and warns from it, and
-// reports of a file's extensions read it, so the two cannot disagree. README.md's glTF extension table
+// `wavepath info` reports from it, so the two cannot disagree. README.md's glTF extension table
 // lists the same names with the same status (tests/gltf/test_gltf_extensions.cpp compares them).
 //
 // Each extension a file lists gets one status:
