@@ -110,9 +110,9 @@ TEST(PackedSize, LayoutAgreesWithPackScene) {
       for (std::uint64_t max_buffer : {kSceneBufferReach, one / 2, one / 3}) {
         const PackedScene packed = pack_scene(s, b, x, max_buffer);
         // Only the punctual light is counted up front: a lower bound.
-        c.punctual_lights = s.lights.size();
+        c.lights = s.lights.size();
         EXPECT_LE(scene_layout(c, bvh_bytes(b), max_buffer).total_bytes(), one);
-        c.punctual_lights = lights.lights.size();
+        c.lights = lights.lights.size();
         const SceneLayout layout = scene_layout(c, bvh_bytes(b), max_buffer);
         ASSERT_EQ(layout.buffer_bytes.size(), packed.buffers.size());
         for (std::size_t i = 0; i < packed.buffers.size(); ++i) {

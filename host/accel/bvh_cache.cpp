@@ -123,13 +123,13 @@ std::optional<Bvh> read_entry(std::FILE* f, std::uint64_t key, std::size_t trian
   return b;
 }
 
-std::string entry_path(const std::string& dir, std::uint64_t key) {
+}  // namespace
+
+std::string cache_entry_path(const std::string& dir, std::uint64_t key) {
   char name[32];
   std::snprintf(name, sizeof name, "%016llx.bvh", static_cast<unsigned long long>(key));
   return dir + "/" + name;
 }
-
-}  // namespace
 
 std::uint64_t cache_key(const BuildInput& input, const BuildOptions& options) {
   Hasher h;
@@ -154,7 +154,7 @@ std::uint64_t cache_key(const BuildInput& input, const BuildOptions& options) {
 std::optional<Bvh> cache_load(const std::string& dir, std::uint64_t key, std::size_t triangle_count,
                               const BuildOptions& options) {
   if (dir.empty()) return std::nullopt;
-  std::FILE* f = std::fopen(entry_path(dir, key).c_str(), "rb");
+  std::FILE* f = std::fopen(cache_entry_path(dir, key).c_str(), "rb");
   if (!f) return std::nullopt;
   std::optional<Bvh> b;
   try {
@@ -184,7 +184,7 @@ void cache_store(const std::string& dir, std::uint64_t key, const Bvh& b) {
   h.counts[1] = b.triangles.size();
   h.counts[2] = b.nodes8.size();
   h.counts[3] = b.blocks.size();
-  write_file_atomically(entry_path(dir, key), [&](std::FILE* f) {
+  write_file_atomically(cache_entry_path(dir, key), [&](std::FILE* f) {
     Hasher sum;
     sum.bytes(&h, sizeof h);
     return std::fwrite(&h, sizeof h, 1, f) == 1 && write_array(f, b.nodes, sum) &&

@@ -35,6 +35,9 @@ static_assert(sizeof(CacheHeader) == 120, "CacheHeader has no implicit padding")
 // The key of `input` built with `options`.
 std::uint64_t cache_key(const BuildInput& input, const BuildOptions& options);
 
+// The file of entry `key` in `dir`: <dir>/<key as 16 hex digits>.bvh.
+std::string cache_entry_path(const std::string& dir, std::uint64_t key);
+
 // The entry `key` for a scene of `triangle_count` triangles built with `options`, or nullopt when
 // it is missing or fails any of the checks above.
 std::optional<Bvh> cache_load(const std::string& dir, std::uint64_t key, std::size_t triangle_count,

@@ -1,4 +1,5 @@
-// The commands of the command line: `wavepath render`, `wavepath merge`, `wavepath devices`.
+// The commands of the command line: `wavepath render`, `wavepath merge`, `wavepath devices`
+// (`wavepath info` has a header of its own, info.h).
 #pragma once
 
 #include <chrono>

@@ -1,5 +1,6 @@
 // wavepath: the command line. `wavepath render SCENE`, `wavepath merge FILM...` and
-// `wavepath devices` (host/cli/commands.h); their options in host/cli/options.h.
+// `wavepath devices` (host/cli/commands.h; their options in host/cli/options.h), and
+// `wavepath info SCENE` (host/cli/info.h).
 // Errors of every kind end here, in one place: one line on stderr, exit status 1.
 #include <algorithm>
 #include <chrono>
@@ -9,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "host/cli/commands.h"
+#include "host/cli/info.h"
 #include "host/cli/options.h"
 
 int main(int argc, char** argv) {
@@ -33,6 +35,12 @@ int main(int argc, char** argv) {
       "merge",
       "Merge .wpfilm films of one render's sample ranges (any order) into one film or image");
   add_merge_options(merge, cli);
+  InfoOptions info_options;
+  CLI::App* info = app.add_subcommand(
+      "info",
+      "Describe a glTF scene as wavepath loads it: contents, extensions, the device memory a "
+      "render needs, the BVH cache; no device, no rendering");
+  add_info_options(info, info_options);
 
   try {
     app.parse(argc, argv);
@@ -43,6 +51,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (devices->parsed()) return list_devices();
+    if (info->parsed()) return info_command(info_options);
     if (merge->parsed()) {
       check_exposure(cli);
       return merge_command(cli);

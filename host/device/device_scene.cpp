@@ -36,18 +36,6 @@ std::string too_many_texels() {
   return "scene too large for the device: more than 2^32 texels in its images";
 }
 
-// "2.50 GiB", "3.2 MiB" or "900 bytes".
-std::string human_bytes(std::uint64_t bytes) {
-  char text[48];
-  if (bytes >= (1ull << 30))
-    std::snprintf(text, sizeof(text), "%.2f GiB", double(bytes) / double(1ull << 30));
-  else if (bytes >= (1ull << 20))
-    std::snprintf(text, sizeof(text), "%.1f MiB", double(bytes) / double(1ull << 20));
-  else
-    std::snprintf(text, sizeof(text), "%llu bytes", static_cast<unsigned long long>(bytes));
-  return text;
-}
-
 // The arrays pack_scene packs, in its order (SceneDesc's); the environment's three come last and
 // only with a map.
 constexpr std::array<const char*, 18> kArrayNames = {"BVH node",
@@ -316,6 +304,7 @@ SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint
   std::uint64_t total = 0;
   for (const std::uint64_t size : sizes) total += padded(size);
   SceneLayout layout;
+  layout.sizes = sizes;
   for (std::size_t i = 0; i < sizes.size(); ++i) {
     const std::uint64_t size = padded(sizes[i]);
     if (size > max_buffer)
@@ -335,6 +324,21 @@ SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint
   return layout;
 }
 
+std::string human_bytes(std::uint64_t bytes) {
+  char text[48];
+  if (bytes >= (1ull << 30))
+    std::snprintf(text, sizeof(text), "%.2f GiB", double(bytes) / double(1ull << 30));
+  else if (bytes >= (1ull << 20))
+    std::snprintf(text, sizeof(text), "%.1f MiB", double(bytes) / double(1ull << 20));
+  else
+    std::snprintf(text, sizeof(text), "%llu bytes", static_cast<unsigned long long>(bytes));
+  return text;
+}
+
+const char* scene_array_name(std::size_t index) {
+  return kArrayNames.at(index);
+}
+
 SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env) {
   SceneCounts c;
   c.triangles = scene.triangle_count();
@@ -344,7 +348,7 @@ SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env) {
   c.images = scene.images.size();
   for (const Image& img : scene.images)
     c.texels += std::uint64_t(std::max(img.width, 0)) * std::uint64_t(std::max(img.height, 0));
-  c.punctual_lights = scene.lights.size();
+  c.lights = scene.lights.size();
   if (env) {
     c.env_texels = env->texels.size();
     c.env_marginal = env->marginal.size();
@@ -389,9 +393,9 @@ SceneLayout scene_layout(const SceneCounts& c, const BvhBytes& bvh, std::uint64_
                                       c.materials * sizeof(dev::Material),
                                       c.textures * sizeof(dev::TextureRef),
                                       c.images * sizeof(dev::TextureImage),
-                                      c.texels * sizeof(dev::uint),
-                                      c.punctual_lights * sizeof(dev::Light),
-                                      c.punctual_lights * sizeof(dev::LightAlias),
+                                      c.texels * kTexelBytes,
+                                      c.lights * sizeof(dev::Light),
+                                      c.lights * sizeof(dev::LightAlias),
                                       c.triangles * sizeof(std::uint32_t)};  // tri_light
   if (c.env_texels || c.env_marginal || c.env_conditional) {
     sizes.push_back(c.env_texels * sizeof(glm::vec4));

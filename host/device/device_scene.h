@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <new>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -78,6 +79,7 @@ struct SceneLayout {
     std::uint64_t offset = 0;  // bytes, a multiple of WP_SCENE_ALIGN
   };
   std::vector<Place> places;                // per array
+  std::vector<std::uint64_t> sizes;         // per array: its bytes (unpadded)
   std::vector<std::uint64_t> buffer_bytes;  // per buffer: where its last array ends (padded)
   std::uint64_t total_bytes() const;
   // Each array's buffer in WP_SCENE_BUFFER_BITS bits, the first array's lowest (0: one buffer).
@@ -88,6 +90,12 @@ struct SceneLayout {
 // WP_SCENE_BUFFERS buffers would be needed. Larger sizes never need fewer buffers (each array's
 // buffer and end only move forward), so a layout of lower bounds that fails means the real fails.
 SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint64_t max_buffer);
+// What array `index` of a layout holds, e.g. "BVH node", "texel" (the words of the errors above).
+const char* scene_array_name(std::size_t index);
+// "2.50 GiB", "3.2 MiB" or "900 bytes", as the errors above write sizes.
+std::string human_bytes(std::uint64_t bytes);
+// The bytes of one texel in the packed images: RGBA8 in one uint, R in the lowest byte.
+inline constexpr std::uint64_t kTexelBytes = sizeof(dev::uint);
 
 // The size check of pack_scene, ahead of it: a scene too large to pack fails before its BVH is
 // built (minutes, and an entry in the BVH cache, for tens of millions of triangles).
@@ -96,7 +104,9 @@ SceneLayout plan_scene_layout(const std::vector<std::uint64_t>& sizes, std::uint
 struct SceneCounts {
   std::uint64_t triangles = 0, vertices = 0;
   std::uint64_t materials = 0, textures = 0, images = 0, texels = 0;
-  std::uint64_t punctual_lights = 0;  // a lower bound on the light table's lights
+  // The light table's lights: scene_counts gives the punctual lights, a lower bound; the table's
+  // size (LightTable::lights) makes the layout exact.
+  std::uint64_t lights = 0;
   std::uint64_t env_texels = 0, env_marginal = 0, env_conditional = 0;  // no map: 0
 };
 SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env);  // env may be null

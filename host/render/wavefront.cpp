@@ -64,13 +64,32 @@ std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings
   return device.max_alloc ? device.max_alloc : kSceneBufferReach;
 }
 
+WaveShape wave_shape(const RenderSettings& settings) {
+  const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
+  WaveShape wave;
+  wave.pixels = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
+  const std::size_t multi = settings.wave_size ? settings.wave_size : kMultiSamplePaths;
+  wave.samples = std::max<std::size_t>(1, multi / wave.pixels);
+  return wave;
+}
+
+StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features) {
+  StateMemory m;
+  m.wave = wave_shape(settings);
+  m.path_state = path_state_layout(m.wave.paths(), settings.aov, features, settings.fused);
+  m.queues = std::uint64_t(WP_QUEUE_COUNT) * m.wave.paths() * sizeof(dev::uint);
+  m.counters = WP_COUNTER_COUNT * sizeof(dev::uint);
+  const std::uint64_t pixels = std::uint64_t(settings.width) * std::uint64_t(settings.height);
+  m.film = pixels * WP_FILM_WORDS(settings.aov) * sizeof(std::uint64_t);
+  return m;
+}
+
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
     : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
-  const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
-  wave_size_ = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
-  const std::size_t multi = settings.wave_size ? settings.wave_size : kMultiSamplePaths;
-  samples_per_wave_ = std::max<std::size_t>(1, multi / wave_size_);
+  const WaveShape wave = wave_shape(settings);
+  wave_size_ = wave.pixels;
+  samples_per_wave_ = wave.samples;
   // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
   // of it) and compiles every kernel again for each new one, seconds each time.
   local_size_ = settings.local_size ? settings.local_size : 64;
@@ -84,7 +103,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   const bool prefetch =
       settings.prefetch && !device.gpu && device.platform_name == "Portable Computing Language";
   options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
-  path_state_ = path_state_layout(wave_paths(), settings.aov, features_, settings.fused);
+  memory_ = state_memory(settings, features_);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
   try {
@@ -124,13 +143,11 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
 
 void Wavefront::allocate_state() {
   const cl::Context& ctx = rt_.context();
-  const std::size_t pixels = std::size_t(settings_.width) * std::size_t(settings_.height);
-  path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, path_state_.bytes);
-  queue_slots_ =
-      cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_QUEUE_COUNT * wave_paths() * sizeof(dev::uint));
-  counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, WP_COUNTER_COUNT * sizeof(dev::uint));
-  const std::size_t film_words = pixels * WP_FILM_WORDS(settings_.aov);
-  film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, film_words * sizeof(std::uint64_t));
+  path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.path_state.bytes);
+  queue_slots_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.queues);
+  counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.counters);
+  const std::size_t film_words = memory_.film / sizeof(std::uint64_t);
+  film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.film);
   // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
   // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every host
   // write, sized to that write, so a fill (stored one pattern at a time) or a partial write leaves
@@ -173,7 +190,7 @@ cl::Kernel& Wavefront::kernel(Stage stage) {
     k = cl::Kernel(program_, stage_name(stage));
     cl_uint arg = set_scene_args(k, 0, scene_);
     k.setArg(arg++, path_buf_);
-    k.setArg(arg++, path_state_.layout);
+    k.setArg(arg++, memory_.path_state.layout);
     k.setArg(arg++, queue_slots_);
     k.setArg(arg++, counters_);
     launch_arg_ = arg++;
@@ -335,7 +352,7 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
 
 Wavefront::Snapshot Wavefront::snapshot() {
   Snapshot s;
-  s.paths.resize(path_state_.bytes);
+  s.paths.resize(memory_.path_state.bytes);
   s.slots.resize(WP_QUEUE_COUNT * wave_paths());
   s.counters.resize(WP_COUNTER_COUNT);
   auto& q = rt_.queue();

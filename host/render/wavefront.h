@@ -96,6 +96,26 @@ constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 // The most bytes of one scene buffer on `device` with `settings`.
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
 
+// The paths of one wave for `settings` (RenderSettings::wave_size): `pixels` pixels, `samples`
+// samples of each.
+struct WaveShape {
+  std::size_t pixels = 0, samples = 1;
+  std::size_t paths() const { return pixels * samples; }
+};
+WaveShape wave_shape(const RenderSettings& settings);
+
+// The device memory a Wavefront allocates besides the packed scene, for `settings` and a program
+// of `features` (they decide the path state's optional fields).
+struct StateMemory {
+  WaveShape wave;
+  PathStateLayout path_state;  // the path-state buffer (path_state.h)
+  std::uint64_t queues = 0;    // WP_QUEUE_COUNT queues of a wave's path slots
+  std::uint64_t counters = 0;  // WP_COUNTER_COUNT
+  std::uint64_t film = 0;      // the film's fixed-point sums (kernels/shared/film.h)
+  std::uint64_t total() const { return path_state.bytes + queues + counters + film; }
+};
+StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features);
+
 // Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
 struct StageTimes {
   std::array<double, kStageCount> seconds{};
@@ -171,7 +191,7 @@ class Wavefront {
 
   const SceneFeatures& features() const { return features_; }
   const LightTable& lights() const { return lights_; }
-  const PathStateLayout& path_state() const { return path_state_; }
+  const PathStateLayout& path_state() const { return memory_.path_state; }
   // Pixels per wave (one sample of each, or samples_per_wave() of them), and path slots per wave.
   std::size_t wave_size() const { return wave_size_; }
   std::size_t samples_per_wave() const { return samples_per_wave_; }
@@ -218,7 +238,7 @@ class Wavefront {
   const Pipeline& pipeline_;  // the stages a wave runs (RenderSettings::fused)
   SceneFeatures features_;
   LightTable lights_;
-  PathStateLayout path_state_;
+  StateMemory memory_;  // the sizes of the buffers below but scene_
   std::size_t wave_size_ = 0;
   std::size_t samples_per_wave_ = 1;
   std::size_t local_size_ = 0;

@@ -21,6 +21,7 @@
 #include "host/scene/view.h"
 #include "host/util/error.h"
 #include "host/util/fnv1a.h"
+#include "host/scene/gltf_extensions.h"
 #include "host/scene/gltf_material.h"
 #include "host/scene/gltf_nodes.h"
 #include "host/scene/gltf_primitive.h"
@@ -28,16 +29,6 @@
 
 namespace wp {
 namespace {
-
-const std::set<std::string> kSupportedExtensions = {
-    "KHR_lights_punctual",        "KHR_materials_anisotropy",
-    "KHR_materials_clearcoat",    "KHR_materials_diffuse_transmission",
-    "KHR_materials_dispersion",   "KHR_materials_emissive_strength",
-    "KHR_materials_ior",          "KHR_materials_iridescence",
-    "KHR_materials_sheen",        "KHR_materials_specular",
-    "KHR_materials_transmission", "KHR_materials_unlit",
-    "KHR_materials_variants",     "KHR_materials_volume",
-    "KHR_mesh_quantization",      "KHR_texture_transform"};
 
 constexpr const char* kVariants = "KHR_materials_variants";
 
@@ -181,18 +172,23 @@ tinygltf::Model parse(const std::string& path, std::vector<std::string>* warning
   return model;
 }
 
-// Errors for required extensions wavepath lacks; a warning for each other unsupported one.
+// The file's extensions as the table of gltf_extensions.h has them: refused ones (required, not
+// supported) are an error naming them; a warning for each ignored one, saying what that means.
 void check_extensions(const tinygltf::Model& model, const std::string& path,
                       std::vector<std::string>* warnings) {
-  std::string missing;
-  for (const std::string& name : model.extensionsRequired)
-    if (!kSupportedExtensions.count(name)) missing += (missing.empty() ? "" : ", ") + name;
-  if (!missing.empty())
-    throw Error(path + ": requires unsupported extension" +
-                (missing.find(',') != std::string::npos ? "s " : " ") + missing);
-  for (const std::string& name : model.extensionsUsed)
-    if (!kSupportedExtensions.count(name))
-      warnings->push_back(path + ": ignoring unsupported extension " + name);
+  std::vector<ExtensionUse> uses = extension_uses(model.extensionsUsed, model.extensionsRequired);
+  std::string refused;
+  for (const ExtensionUse& use : uses)
+    if (use.support == ExtensionSupport::kRefused)
+      refused += (refused.empty() ? "" : ", ") + use.name;
+  if (!refused.empty())
+    throw RefusedExtensions(path + ": requires unsupported extension" +
+                                (refused.find(',') != std::string::npos ? "s " : " ") + refused,
+                            std::move(uses));
+  for (const ExtensionUse& use : uses)
+    if (use.support == ExtensionSupport::kIgnored)
+      warnings->push_back(path + ": ignoring unsupported extension " + use.name + " (" + use.note +
+                          ")");
 }
 
 // A name from the file for a one-line message: control characters become '?'.
@@ -264,6 +260,7 @@ class SceneBuilder {
  private:
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
+  void count_placement(const tinygltf::Node& node);
   std::uint32_t material_index(int material);
   int primitive_material(const tinygltf::Primitive& p) const;
   gltf::VertexNeeds vertex_needs(std::uint32_t material) const;
@@ -276,6 +273,7 @@ class SceneBuilder {
   std::optional<std::uint32_t> default_material_;
   gltf::VertexNeeds file_needs_;  // uv1 and tangents: whether the scene keeps them at all
   std::set<std::pair<int, std::size_t>> warned_;  // (mesh, primitive): instances warn once
+  std::set<int> placed_;                          // the meshes nodes place (GltfSummary)
 };
 
 // Depth-first, children in order, with an explicit stack: node order defines camera order, and
@@ -321,7 +319,10 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
   const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
   const std::string where = "node " + std::to_string(node_index) + ": ";
   try {
-    if (node.mesh >= 0) add_mesh(node.mesh, world);
+    if (node.mesh >= 0) {
+      add_mesh(node.mesh, world);
+      count_placement(node);
+    }
     if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
     const int light = gltf::node_light(node, node_index);
     if (light >= 0) scene_.lights.push_back(gltf::make_light(model_, light, world));
@@ -362,6 +363,27 @@ void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
                   e.what());
     }
   }
+}
+
+// GltfSummary's counts for a node that places a mesh. EXT_mesh_gpu_instancing is ignored (not
+// loaded), so its instances are counted, from the first attribute's accessor (the extension's
+// attributes all have the instance count), and nothing in it is an error.
+void SceneBuilder::count_placement(const tinygltf::Node& node) {
+  GltfSummary& summary = scene_.gltf;
+  ++summary.mesh_nodes;
+  placed_.insert(node.mesh);
+  summary.meshes_placed = placed_.size();
+  const auto it = node.extensions.find("EXT_mesh_gpu_instancing");
+  if (it == node.extensions.end()) return;
+  ++summary.gpu_instanced_nodes;
+  const tinygltf::Value& ext = it->second;
+  if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject()) return;
+  const tinygltf::Value& attributes = ext.Get("attributes");
+  const std::vector<std::string> keys = attributes.Keys();
+  if (keys.empty() || !attributes.Get(keys.front()).IsInt()) return;
+  const int accessor = attributes.Get(keys.front()).GetNumberAsInt();
+  if (accessor >= 0 && static_cast<std::size_t>(accessor) < model_.accessors.size())
+    summary.gpu_instances += model_.accessors[static_cast<std::size_t>(accessor)].count;
 }
 
 // Materials keep their glTF indices; glTF's default material follows them, added on first use.
@@ -463,6 +485,12 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
     if (image.bufferView < 0)
       scene.digest = fnv1a64(image.image.data(), image.image.size(), scene.digest);
   check_extensions(model, path, &scene.warnings);
+  scene.gltf.extensions_used = model.extensionsUsed;
+  scene.gltf.extensions_required = model.extensionsRequired;
+  scene.gltf.meshes = model.meshes.size();
+  scene.gltf.images = model.images.size();
+  scene.gltf.textures = model.textures.size();
+  scene.gltf.materials = model.materials.size();
   try {
     // glTF 1.0 files differ in structure; tinygltf reads some of them as 2.0 nonsense.
     if (model.asset.version.rfind("2.", 0) != 0)

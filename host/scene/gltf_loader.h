@@ -20,8 +20,9 @@ struct LoadOptions {
 // Throws wp::Error naming the file and the cause when the file is missing, unreadable or
 // malformed (JSON nested deeper than 64 levels, asset.version not 2.x, a primitive mode outside
 // 0-6, a byteStride below its element size, NaN or Inf in a float vertex attribute included), or
-// when it requires an extension wavepath does not support. Unsupported optional extensions and
-// non-triangle primitives are skipped with a line in Scene::warnings. A scene without triangles
+// when it requires an extension wavepath does not support (RefusedExtensions; the statuses are
+// gltf_extensions.h's table). Unsupported optional extensions and non-triangle primitives are
+// skipped with a line in Scene::warnings. A scene without triangles
 // is valid glTF: it loads, with a warning, and bounds at the origin.
 Scene load_gltf(const std::string& path, const LoadOptions& options = {});
 

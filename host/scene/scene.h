@@ -139,6 +139,21 @@ struct Camera {
   float focus_distance = 1.0f;
 };
 
+// What the glTF file holds beyond the scene's flat arrays, for reports (`wavepath info`). Filled
+// by the loader.
+struct GltfSummary {
+  std::vector<std::string> extensions_used, extensions_required;  // as the file lists them
+  std::size_t meshes = 0;                                         // glTF meshes in the file
+  std::size_t meshes_placed = 0;  // distinct meshes the default scene's nodes place
+  // Nodes of the default scene with a mesh: each places a copy of its mesh's triangles.
+  std::size_t mesh_nodes = 0;
+  // EXT_mesh_gpu_instancing (ignored, gltf_extensions.h): the nodes of mesh_nodes that have it and
+  // their instances in all, which are not loaded (each such node places its mesh once).
+  std::size_t gpu_instanced_nodes = 0, gpu_instances = 0;
+  std::size_t images = 0, textures = 0;  // in the file (Scene::images: those materials use)
+  std::size_t materials = 0;  // in the file (Scene::materials adds glTF's default one if used)
+};
+
 struct Scene {
   std::string source;  // file the scene came from
   // FNV-1a 64 (fnv1a.h) of the bytes the scene was loaded from: the glTF or GLB file, then the
@@ -174,6 +189,7 @@ struct Scene {
   glm::vec3 bounds_lo{0.0f}, bounds_hi{0.0f};
 
   std::vector<std::string> warnings;  // one line each: skipped primitives, unsupported extensions
+  GltfSummary gltf;
 
   std::size_t triangle_count() const { return indices.size() / 3; }
 };

@@ -42,6 +42,32 @@ TEST(GltfLoader, ExtensionWarnings) {
   EXPECT_TRUE(s.images.empty());
 }
 
+// GltfSummary: mesh 0 placed by two nodes (one with 3 EXT_mesh_gpu_instancing instances, which
+// are not loaded), mesh 1 by none, a third node with no mesh; the file's lists as it has them.
+TEST(GltfLoader, Summary) {
+  Gltf g = one_triangle("");
+  g.mesh({prim({{"POSITION", 0}})});
+  const int offsets = g.vec3s({{0, 0, 0}, {5, 0, 0}, {10, 0, 0}});
+  g.node(R"("mesh":0,"extensions":{"EXT_mesh_gpu_instancing":{"attributes":{"TRANSLATION":)" +
+             std::to_string(offsets) + "}}}",
+         true);
+  g.node(R"("translation":[1,0,0])", true);
+  g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing","KHR_texture_transform"],)"
+          R"("extensionsRequired":["KHR_texture_transform"])";
+  const wp::Scene s = wp::load_gltf(g.write("summary.gltf"));
+  EXPECT_EQ(s.triangle_count(), 2u);
+  EXPECT_EQ(s.gltf.meshes, 2u);
+  EXPECT_EQ(s.gltf.meshes_placed, 1u);
+  EXPECT_EQ(s.gltf.mesh_nodes, 2u);
+  EXPECT_EQ(s.gltf.gpu_instanced_nodes, 1u);
+  EXPECT_EQ(s.gltf.gpu_instances, 3u);
+  EXPECT_EQ(s.gltf.extensions_used,
+            (std::vector<std::string>{"EXT_mesh_gpu_instancing", "KHR_texture_transform"}));
+  EXPECT_EQ(s.gltf.extensions_required, std::vector<std::string>{"KHR_texture_transform"});
+  EXPECT_EQ(s.gltf.materials, 0u);
+  EXPECT_EQ(s.materials.size(), 1u);  // glTF's default material
+}
+
 TEST(GltfLoader, FramingCamera) {
   wp::Scene s;
   s.bounds_lo = vec3(-1, 0, -3);
