@@ -12,6 +12,7 @@
 #include "host/cli/progress.h"
 #include "host/cli/stop_signals.h"
 #include "host/device/cl_runtime.h"
+#include "host/film/denoise.h"
 #include "host/film/film.h"
 #include "host/film/image_io.h"
 #include "host/render/render.h"
@@ -49,9 +50,12 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 // Writes every output as one set (image_io.h, write_files): images by extension from `film`'s
-// mean, with the layers asked for (--variance, --aov), and .wpfilm files from `film` itself.
+// mean, with the layers asked for (--variance, --aov), .wpfilm files from `film` itself, and with
+// `denoiser` (--denoise) the denoised image beside each image output (its EXR without layers).
+// The denoising runs before anything is written: an OIDN error leaves no output.
 void write_outputs(const CliOptions& cli, const wp::Film& film,
-                   const std::map<std::string, std::string>& exr_attributes) {
+                   const std::map<std::string, std::string>& exr_attributes,
+                   const wp::Denoiser* denoiser) {
   wp::PngOptions png;
   png.exposure = cli.exposure;
   png.tonemap = wp::tonemap_from_name(cli.tonemap);
@@ -63,13 +67,32 @@ void write_outputs(const CliOptions& cli, const wp::Film& film,
   std::vector<wp::ImageLayer> layers;
   if (cli.variance)
     layers.push_back({"variance", {"R", "G", "B"}, std::move(film_images.variance)});
+  const auto no_aovs = [](const std::string& what) {
+    return wp::Error(what + ": the film holds no AOVs (render it with --denoise or --aov)");
+  };
   for (const std::string& aov : cli.aovs) {  // in the order given
-    if (!film.info().aov) throw wp::Error("--aov " + aov + ": the film holds no AOVs");
+    if (!film.info().aov) throw no_aovs("--aov " + aov);
     if (aov == "albedo") layers.push_back({aov, {"R", "G", "B"}, film_images.albedo});
     if (aov == "normal") layers.push_back({aov, {"X", "Y", "Z"}, film_images.normal});
     if (aov == "depth") layers.push_back({aov, {"Z"}, film_images.depth});
   }
   std::vector<wp::OutputFile> files = wp::image_files(images, image, exr_attributes, png, layers);
+  // With a denoiser: the denoised image and what its files refer to until write_files is done.
+  wp::ImageRgb denoised;
+  std::vector<std::string> denoised_paths;
+  const std::vector<wp::ImageLayer> no_layers;
+  std::map<std::string, std::string> denoised_attributes = exr_attributes;
+  if (denoiser && !images.empty()) {
+    if (!film.info().aov) throw no_aovs("--denoise");
+    denoised = {image.width, image.height,
+                denoiser->denoise(image.width, image.height, image.rgb, film_images.albedo,
+                                  film_images.normal)};
+    for (const auto& o : images) denoised_paths.push_back(wp::denoised_path(o));
+    denoised_attributes["wavepath:denoiser"] =
+        denoiser->description() + ": RT filter, hdr, prefiltered albedo and normal, cleanAux";
+    for (auto& f : wp::image_files(denoised_paths, denoised, denoised_attributes, png, no_layers))
+      files.push_back(std::move(f));
+  }
   for (const auto& o : cli.outputs)
     if (is_film(o)) files.push_back({o, [&film](const std::string& temp) { film.write(temp); }});
   wp::write_files(files);
@@ -154,7 +177,8 @@ int finish_render(const CliOptions& cli, const wp::RenderSettings& settings,
                  static_cast<unsigned long long>(report.nonfinite_samples));
   const int done = int(report.sample_end) - settings.sample_begin;
   if (cli.json)
-    std::cout << wp::report_json(settings, report, part.load_seconds, total_seconds, cli.outputs)
+    std::cout << wp::report_json(settings, report, part.load_seconds, total_seconds,
+                                 written_files(cli))
               << "\n";
   else if (!cli.quiet)
     std::fprintf(stderr,
@@ -163,11 +187,11 @@ int finish_render(const CliOptions& cli, const wp::RenderSettings& settings,
                  cli.scene.c_str(), done, settings.sample_begin, report.sample_end,
                  wp::stop_reason_name(report.stop), report.render_seconds,
                  report.samples_per_second(settings), report.device.c_str(),
-                 join(cli.outputs).c_str());
+                 join(written_files(cli)).c_str());
   if (const int stop_signal = part.stop_signal) {  // said even with --quiet: the exit status alone
                                                    // would not say what is kept
     std::fprintf(stderr, "wavepath: interrupted by %s after %d of %d samples; wrote %s%s\n",
-                 wp::signal_name(stop_signal), done, settings.spp, join(cli.outputs).c_str(),
+                 wp::signal_name(stop_signal), done, settings.spp, join(written_files(cli)).c_str(),
                  cli.checkpoint.empty() ? ""
                                         : ("; the checkpoint " + cli.checkpoint +
                                            " continues with --resume " + cli.checkpoint)
@@ -202,6 +226,7 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   // ever: a failure is kept in `mine` and the steps after it are skipped. Alone, it is thrown.
   wp::RankPart mine;
   RenderPart part;
+  std::optional<wp::Denoiser> denoiser;  // rank 0's, which writes the outputs
   const auto attempt = [&](const auto& step) {
     if (!mine.error.empty()) return;
     try {
@@ -211,7 +236,10 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
       std::tie(mine.error, mine.details) = describe(std::current_exception());
     }
   };
-  attempt([&] { prepare_render(render, cli, settings, ranks); });
+  attempt([&] {
+    prepare_render(render, cli, settings, ranks);
+    if (cli.denoise && ranks.root()) denoiser = wp::Denoiser::load();  // fails before rendering
+  });
   // Options and outputs are agreed on before any rank spends time rendering.
   if (ranks.all(mine.error.empty()))
     attempt([&] { part = render_part(cli, settings, ranks, program_start); });
@@ -239,16 +267,21 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
   attributes["wavepath:render_key"] = result.film.info().key;
   if (!cli.variant.empty()) attributes["wavepath:variant"] = cli.variant;
-  write_outputs(cli, result.film, attributes);
+  write_outputs(cli, result.film, attributes, denoiser ? &*denoiser : nullptr);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return finish_render(cli, settings, result.report, part, total);
 }
 
 int merge_command(CliOptions& cli) {
-  check_outputs(cli.outputs);
+  check_outputs(written_files(cli));
+  std::optional<wp::Denoiser> denoiser;
+  if (cli.denoise) denoiser = wp::Denoiser::load();
   std::vector<wp::FilmInfo> parts;
   for (const auto& part : cli.parts) parts.push_back(wp::Film::read_info(part));
+  if (cli.denoise && !parts[0].aov)
+    throw wp::Error("--denoise: " + cli.parts[0] +
+                    " holds no AOVs (render the parts with --denoise or --aov)");
   for (std::size_t i = 1; i < parts.size(); ++i) {
     const std::string problem = wp::film_identity_problem(parts[0], parts[i]);
     if (!problem.empty())
@@ -276,15 +309,16 @@ int merge_command(CliOptions& cli) {
     }
   }
   const wp::FilmInfo& info = merged.info();
-  write_outputs(cli, merged, wp::film_exr_attributes(info));
+  write_outputs(cli, merged, wp::film_exr_attributes(info), denoiser ? &*denoiser : nullptr);
   if (cli.json) {
     std::cout << "{\"parts\":" << parts.size() << ",\"spp\":" << info.samples()
               << ",\"sample_begin\":" << info.sample_begin << ",\"sample_end\":" << info.sample_end
               << ",\"width\":" << info.width << ",\"height\":" << info.height
               << ",\"device\":" << wp::json_string(info.device)
               << ",\"nonfinite_samples\":" << info.nonfinite_samples << ",\"outputs\":[";
-    for (std::size_t i = 0; i < cli.outputs.size(); ++i)
-      std::cout << (i ? "," : "") << wp::json_string(cli.outputs[i]);
+    const std::vector<std::string> written = written_files(cli);
+    for (std::size_t i = 0; i < written.size(); ++i)
+      std::cout << (i ? "," : "") << wp::json_string(written[i]);
     std::cout << "]}\n";
   } else if (!cli.quiet) {
     std::fprintf(stderr, "wavepath: merged %zu film(s): samples %u:%u, %dx%d; wrote %s\n",

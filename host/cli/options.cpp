@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 
+#include "host/film/denoise.h"
 #include "host/film/image_io.h"
 #include "host/lights/environment.h"
 #include "host/render/render.h"
@@ -98,6 +99,18 @@ wp::View view_options(const CLI::App& render, const CliOptions& cli) {
   if (render.count("--focus-distance")) v.focus_distance = cli.focus_distance;
   v.aperture = cli.aperture;
   return v;
+}
+
+// --denoise, the same for render and merge.
+void add_denoise_option(CLI::App* app, CliOptions& cli, const char* what) {
+  app->add_flag("--denoise", cli.denoise,
+                std::string("Also write X.denoised.exr/.png/.pfm beside each image output "
+                            "X.exr/.png/.pfm: the image denoised by Intel Open Image Denoise's RT "
+                            "filter, guided by the albedo and normal AOVs ") +
+                    what +
+                    "; loaded at run time from $WAVEPATH_OIDN (the library or its folder), "
+                    "else what tools/setup.sh --denoise installs, else the system's "
+                    "libOpenImageDenoise.so.2 (docs/denoise.md)");
 }
 
 // Ranges CLI11 cannot express and wp::validate (render.h) does not cover: these are the command
@@ -321,6 +334,7 @@ void add_report_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
                   "X.albedo.pfm etc. beside X.pfm; kept in .wpfilm outputs")
       ->delimiter(',')
       ->check(CLI::IsMember(kAovNames));
+  add_denoise_option(app, cli, "(which it implies rendering)");
   app->add_flag("--profile", settings.profile, "Time each kernel (adds stage times to --json)");
   app->add_flag("--json", cli.json,
                 "Print a JSON summary as the last line of stdout (spp, sample_begin, "
@@ -330,6 +344,14 @@ void add_report_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
 }
 
 }  // namespace
+
+std::vector<std::string> written_files(const CliOptions& cli) {
+  std::vector<std::string> files = cli.outputs;
+  if (cli.denoise)
+    for (const auto& o : cli.outputs)
+      if (!is_film(o)) files.push_back(wp::denoised_path(o));
+  return files;
+}
 
 void check_exposure(const CliOptions& cli) {
   if (!std::isfinite(cli.exposure) || std::abs(cli.exposure) > 64.0f)
@@ -361,6 +383,7 @@ void add_merge_options(CLI::App* app, CliOptions& cli) {
                   "Also write these AOVs, which the films must hold (as render --aov)")
       ->delimiter(',')
       ->check(CLI::IsMember(kAovNames));
+  add_denoise_option(app, cli, "(the films must hold AOVs: rendered with --denoise or --aov)");
   app->add_flag("--json", cli.json,
                 "Print a JSON summary (parts, spp, sample_begin, sample_end, width, height, "
                 "device, nonfinite_samples, outputs) as the last line of stdout");
@@ -370,7 +393,7 @@ void add_merge_options(CLI::App* app, CliOptions& cli) {
 void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings& settings,
                     const wp::Ranks& ranks) {
   if (cli.outputs.empty()) cli.outputs = {"render.exr", "render.png"};
-  if (ranks.root()) check_outputs(cli.outputs);
+  if (ranks.root()) check_outputs(written_files(cli));
   apply_samples(render, cli, settings);
   check_options(render, cli, settings);
   if (ranks.size() > 1 && (cli.time_limit > 0 || cli.noise_threshold > 0 ||
@@ -383,7 +406,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   settings.view = view_options(render, cli);
   settings.background = {cli.env_color[0], cli.env_color[1], cli.env_color[2]};
   settings.all_features = cli.features == "all";
-  settings.aov = !cli.aovs.empty();
+  settings.aov = !cli.aovs.empty() || cli.denoise;
   settings.scene_buffer_bytes = cli.scene_buffer_kib * 1024;
   settings.strategy = cli.strategy == "nee"    ? wp::Strategy::kNee
                       : cli.strategy == "bsdf" ? wp::Strategy::kBsdf

@@ -46,6 +46,7 @@ struct CliOptions {
   double checkpoint_every = 60;
   std::string resume;
   std::vector<std::string> aovs;  // --aov, in the order given
+  bool denoise = false;           // --denoise: X.denoised.EXT beside each image output X.EXT
   double progress_every = 10;
   bool json = false;
   bool quiet = false;
@@ -66,6 +67,10 @@ bool is_film(const std::string& path);
 // beside their destination under a temporary name and renamed into place (image_io.h), which
 // needs a writable folder; an existing file that is not writable is not replaced either.
 void check_outputs(const std::vector<std::string>& outputs);
+
+// The files an image output set writes: `outputs`, and with --denoise X.denoised.EXT beside each
+// image output X.EXT (denoise.h), in that order.
+std::vector<std::string> written_files(const CliOptions& cli);
 
 // --exposure is a finite number of stops in [-64, 64].
 void check_exposure(const CliOptions& cli);
