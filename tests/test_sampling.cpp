@@ -31,6 +31,7 @@
 #include <iomanip>
 #include <iostream>
 #include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -533,6 +534,36 @@ TEST(Sampling, CosSinTurn) {
     EXPECT_EQ(v[i].s[0], q[1]) << "u " << q[0];
     EXPECT_EQ(v[i].s[1], q[2]) << "u " << q[0];
   }
+}
+
+// The thin lens's disc sampler (kernels/camera.h): uniform on the unit disc, pdf 1/pi. Binned into
+// 16 rings of equal area (r^2 in steps of 1/16) x 32 sectors, each of probability 1/512, from 2^20
+// independent points of the square (a host Mersenne Twister, so the counts are multinomial and
+// Pearson's statistic chi-square with 511 degrees of freedom); no point may fall outside the disc
+// beyond float rounding (|p| <= 1 + 1e-6).
+TEST(Sampling, ConcentricDisk) {
+  wp::test::KernelHarness h({"trig_kernels.cl"});
+  constexpr std::uint32_t kCount = 1u << 20;
+  constexpr int kRings = 16, kSectors = 32;
+  std::mt19937 rng(20261127);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  std::vector<cl_float2> u(kCount);
+  for (auto& p : u) p.s[0] = uniform(rng), p.s[1] = uniform(rng);
+  cl::Buffer in = h.buffer(u), out = h.buffer<cl_float2>(kCount);
+  h.run("concentric_disk_at", kCount, in, kCount, out);
+  const auto v = h.read<cl_float2>(out, kCount);
+  std::vector<double> observed(kRings * kSectors, 0.0),
+      expected(kRings * kSectors, double(kCount) / (kRings * kSectors));
+  for (const cl_float2& p : v) {
+    const double r2 = double(p.s[0]) * p.s[0] + double(p.s[1]) * p.s[1];
+    ASSERT_LE(r2, 1.0 + 2e-6) << p.s[0] << "," << p.s[1];
+    const double phi = std::atan2(double(p.s[1]), double(p.s[0])) + 3.14159265358979323846;
+    const int ring = std::min(kRings - 1, int(r2 * kRings));
+    const int sector = std::min(kSectors - 1, int(phi / (2 * 3.14159265358979323846) * kSectors));
+    observed[ring * kSectors + sector] += 1.0;
+  }
+  const wp::test::Chi2Result r = wp::test::chi2_test(observed, expected);
+  EXPECT_GT(r.p_value, 1e-4) << r.detail;
 }
 
 TEST(Sampling, CosineHemisphere) {

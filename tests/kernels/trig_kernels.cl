@@ -1,8 +1,14 @@
-/* Test kernel of tests/test_sampling.cpp (Sampling.CosSinTurn): cos_sin_turn (kernels/sampling.h)
- * at given fractions of a turn. */
+/* Test kernels of tests/test_sampling.cpp: cos_sin_turn (Sampling.CosSinTurn) at given fractions of
+ * a turn, and sample_concentric_disk (Sampling.ConcentricDisk) at given points of the square
+ * (kernels/sampling.h). */
 #include "sampling.h"
 
 __kernel void cos_sin_turn_at(__global const float* u, uint count, __global float2* out) {
   const uint i = get_global_id(0);
   if (i < count) out[i] = cos_sin_turn(u[i]);
+}
+
+__kernel void concentric_disk_at(__global const float2* u, uint count, __global float2* out) {
+  const uint i = get_global_id(0);
+  if (i < count) out[i] = sample_concentric_disk(u[i]);
 }
