@@ -7,22 +7,44 @@
  * states the convention), a world direction d is first turned into the map's frame by the inverse
  * of the rotation R about +Y (env_params.y, .z = cos R, sin R): m = (cos R d.x - sin R d.z, d.y,
  * sin R d.x + cos R d.z), then u = (atan2(m.x, -m.z) + pi) / (2 pi), v = theta / pi with theta =
- * atan2(|m.xz|, m.y), and the radiance is texel (floor(u W), floor(v H)) times env_params.x:
- * nearest texel, piecewise constant over (u, v) like the sampling density.
+ * atan2(|m.xz|, m.y), and the radiance is env_params.x times the lookup (--env-filter):
+ *   nearest (WP_ENV_BILINEAR=0): texel (floor(u W), floor(v H)), piecewise constant over (u, v).
+ *   bilinear (WP_ENV_BILINEAR=1): the texel centres sit at ((x + 0.5) / W, (y + 0.5) / H);
+ *     with fx = u W - 0.5, fy = v H - 0.5 the four texels (x0, y0), (x0 + 1, y0), (x0, y0 + 1),
+ *     (x0 + 1, y0 + 1) around (fx, fy), x0 = floor(fx), y0 = floor(fy), are blended with weights
+ *     (1 - tx, tx) x (1 - ty, ty), tx = fx - x0, ty = fy - y0. Columns wrap across the u seam
+ *     (x = -1 is W - 1, x = W is 0). Rows clamp at the poles (y = -1 is 0, y = H is H - 1): within
+ *     half a texel of a pole the map is interpolated along u only, so the pole value depends on
+ *     the direction of approach as it does with nearest lookup (the pole is a null set).
  *
- * Sampling tables (host/lights/environment.cpp fills them), float CDFs:
+ * Sampling tables (host/lights/environment.cpp fills them), float CDFs, built for the filter:
  *   env_marginal[0..H]: over rows; [0] = 0, [H] = 1, row y has probability
  *     P(y) = env_marginal[y+1] - env_marginal[y], proportional to the sum over the row of
- *     luminance x sin(theta at the row's centre), i.e. to luminance x solid angle.
+ *     f(x, y) x sin(theta at the row's centre), i.e. to f x solid angle.
  *     All zero for a black map: nothing to sample (env_sample then returns pdf 0, env_pdf is 0).
  *   env_conditional[y (W+1) + 0..W]: over the columns of row y, [0] = 0, [W] = 1, column x has
- *     P(x | y) = c[x+1] - c[x], proportional to luminance (uniform in a black row, never chosen).
+ *     P(x | y) = c[x+1] - c[x], proportional to f (uniform in a black row, never chosen).
+ * f(x, y) is the texel's luminance for nearest lookup, and for bilinear lookup the largest
+ * luminance of the 3 x 3 texels around it (columns wrapped, rows clamped as in the lookup).
  * env_sample picks a row with u.x and a column with u.y (binary search) and a point uniform in the
  * texel's (u, v) rectangle from the remainders of u.x and u.y within the chosen intervals. Its
  * density over (u, v) is P(y) P(x | y) W H, computed from the very float differences the search
  * used, so it is the exact density of the sampling (a texel whose interval rounded to nothing has
  * density 0 and is left to BSDF sampling). Over solid angle it is divided by the Jacobian
- * |d omega / du dv| = 2 pi^2 sin(theta); at the poles (sin(theta) = 0, a null set) the pdf is 0. */
+ * |d omega / du dv| = 2 pi^2 sin(theta); at the poles (sin(theta) = 0, a null set) the pdf is 0.
+ * The sample's radiance is the lookup at the sampled direction, and env_pdf evaluates that same
+ * piecewise-constant density for BSDF-sampled escaped rays (MIS), whatever the filter.
+ *
+ * Why bilinear lookup with a piecewise-constant density stays unbiased: an estimator L / pdf of
+ * the integral of L needs pdf > 0 wherever L > 0. Over texel (x, y)'s rectangle,
+ * fx lies in [x - 0.5, x + 0.5) and fy in [y - 0.5, y + 0.5), so the bilinear radiance there is a
+ * convex combination of texels within one column (wrapped) and one row (clamped) of (x, y): the
+ * 3 x 3 block. Luminance is linear with positive weights and texels are >= 0, so the luminance of
+ * the blend is at most f(x, y), and L > 0 at a point (some channel > 0) means some texel of the
+ * block with positive weight has luminance > 0, hence f(x, y) > 0 and (up to the float rounding
+ * above, as for nearest) P(x, y) > 0. A black texel next to a bright one thus keeps the bright
+ * one's weight. Since L <= f on each texel, L / pdf is bounded by the constant the nearest tables
+ * give a map whose texels are f: the blurred table costs variance, never bias. */
 #ifndef WP_ENVIRONMENT_H
 #define WP_ENVIRONMENT_H
 
@@ -73,12 +95,40 @@ static inline uint env_find_interval(__global const float* cdf, uint n, float u)
   return lo;
 }
 
+#if WP_ENV_BILINEAR
+/* The bilinear lookup at map coordinates (u, v) in [0, 1]^2 (see the header comment), unscaled. */
+static inline float3 env_bilinear(const SceneView* scene, float u, float v) {
+  const int w = (int)scene->desc->env_width, h = (int)scene->desc->env_height;
+  const float fx = u * (float)w - 0.5f, fy = v * (float)h - 0.5f;
+  const float x_floor = floor(fx), y_floor = floor(fy);
+  const float tx = fx - x_floor, ty = fy - y_floor;
+  int x0 = (int)x_floor, y0 = (int)y_floor;
+  x0 = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0); /* the seam */
+  const int x1 = x0 + 1 == w ? 0 : x0 + 1;
+  const int y1 = clamp(y0 + 1, 0, h - 1); /* the poles */
+  y0 = clamp(y0, 0, h - 1);
+  __global const float4* r0 = scene->env_texels + y0 * w;
+  __global const float4* r1 = scene->env_texels + y1 * w;
+  const float3 top = mix(r0[x0].xyz, r0[x1].xyz, tx);
+  const float3 bottom = mix(r1[x0].xyz, r1[x1].xyz, tx);
+  return mix(top, bottom, ty);
+}
+
+static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
+  const SceneDesc* d = scene->desc;
+  const float3 m = env_to_map(d, dir);
+  const float u = fmax(0.0f, atan2(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
+  const float v = atan2(sqrt(m.x * m.x + m.z * m.z), m.y) * WP_INV_PI;
+  return env_bilinear(scene, u, v) * d->env_params.x;
+}
+#else
 static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
   const SceneDesc* d = scene->desc;
   float sin_theta;
   const uint2 t = env_texel_of(d, env_to_map(d, dir), &sin_theta);
   return scene->env_texels[t.y * d->env_width + t.x].xyz * d->env_params.x;
 }
+#endif
 
 static inline float env_map_pdf(const SceneView* scene, float3 dir) {
   const SceneDesc* d = scene->desc;
@@ -111,7 +161,12 @@ static inline float3 env_map_sample(const SceneView* scene, float2 u, float3* di
   const float sin_theta = sin(theta);
   *dir = env_from_map(d, (float3)(sin_theta * sin(phi), cos(theta), -sin_theta * cos(phi)));
   *pdf = env_texel_pdf(p_row * p_col, w, h, sin_theta);
+#if WP_ENV_BILINEAR
+  return env_bilinear(scene, ((float)x + fx) / (float)w, ((float)y + fy) / (float)h) *
+         d->env_params.x;
+#else
   return scene->env_texels[y * w + x].xyz * d->env_params.x;
+#endif
 }
 
 #endif /* WP_FEATURE_ENVIRONMENT */

@@ -17,6 +17,9 @@
 #ifndef WP_FEATURE_ENVIRONMENT
 #define WP_FEATURE_ENVIRONMENT 1 /* an environment map (else a constant background) */
 #endif
+#ifndef WP_ENV_BILINEAR
+#define WP_ENV_BILINEAR 0 /* --env-filter bilinear: the map's lookup (kernels/environment.h) */
+#endif
 #ifndef WP_FEATURE_VERTEX_COLORS
 #define WP_FEATURE_VERTEX_COLORS 1 /* COLOR_0 multiplies the base colour */
 #endif

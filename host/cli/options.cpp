@@ -241,6 +241,11 @@ void add_scene_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& setti
   app->add_option("--env", cli.env,
                   "Environment map: equirectangular .hdr or .exr, linear radiance; the centre "
                   "of the map is seen looking down -Z, +Y is up");
+  app->add_option("--env-filter", cli.env_filter,
+                  "Environment map lookup: bilinear (interpolated between texel centres) or "
+                  "nearest (the texel, blocky when magnified); importance sampling stays exact")
+      ->check(CLI::IsMember({"bilinear", "nearest"}))
+      ->capture_default_str();
   app->add_option("--env-intensity", settings.env_intensity, "Scale of the environment map")
       ->capture_default_str();
   app->add_option("--env-rotation", settings.env_rotation,
@@ -423,8 +428,11 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   if (!cli.no_kernel_cache) settings.kernel_cache_dir = wp::cache_dir();
   if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);
+  settings.env_filter =
+      cli.env_filter == "nearest" ? wp::EnvFilter::kNearest : wp::EnvFilter::kBilinear;
   if (!cli.env.empty())
-    settings.environment = std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env));
+    settings.environment =
+        std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env, settings.env_filter));
 }
 
 }  // namespace wp::cli

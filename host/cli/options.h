@@ -25,6 +25,7 @@ struct CliOptions {
   std::string device;
   std::vector<float> env_color{0.0f, 0.0f, 0.0f};
   std::string env;
+  std::string env_filter = "bilinear";
   std::string strategy = "mis";
   std::string heuristic = "power";
   std::string light_select = "power";

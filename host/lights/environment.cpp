@@ -389,7 +389,11 @@ void write_cdf(const std::vector<double>& weights, float* out, bool zero_if_empt
 
 }  // namespace
 
-EnvironmentMap load_environment(const std::string& path) {
+const char* env_filter_name(EnvFilter f) {
+  return f == EnvFilter::kBilinear ? "bilinear" : "nearest";
+}
+
+EnvironmentMap load_environment(const std::string& path, EnvFilter filter) {
   EnvironmentMap env;
   env.source = path;
   const std::string ext = lower_extension(path);
@@ -401,7 +405,7 @@ EnvironmentMap load_environment(const std::string& path) {
     read_hdr(path, env);
   else
     read_exr(path, env);
-  build_environment_tables(env);
+  build_environment_tables(env, filter);
   return env;
 }
 
@@ -409,23 +413,39 @@ EnvironmentMap load_environment(const std::string& path) {
 // (2 pi / W) (cos theta_y - cos theta_{y+1}) = (2 pi / W) 2 sin(theta_c) sin(pi / 2H) with
 // theta_c its centre. Weights luminance x sin(theta_c) are therefore proportional to luminance x
 // solid angle, the piecewise-constant density over (u, v) that matches radiance x Jacobian.
-void build_environment_tables(EnvironmentMap& env) {
+// Bilinear tables use f(x, y) = the largest luminance of the 3 x 3 texels around (x, y) instead,
+// which bounds the interpolated luminance over the texel (kernels/environment.h says why).
+void build_environment_tables(EnvironmentMap& env, EnvFilter filter) {
   validate(env);
+  env.filter = filter;
   const std::size_t w = std::size_t(env.width), h = std::size_t(env.height);
+  std::vector<double> lum(w * h);
+  for (std::size_t i = 0; i < w * h; ++i) lum[i] = luminance(env.texels[i]);
+  std::vector<double> bound = lum;
+  if (filter == EnvFilter::kBilinear)
+    for (std::size_t y = 0; y < h; ++y)
+      for (std::size_t x = 0; x < w; ++x) {
+        double m = 0.0;
+        for (std::size_t ry : {y == 0 ? 0 : y - 1, y, std::min(y + 1, h - 1)})
+          for (std::size_t rx : {(x + w - 1) % w, x, (x + 1) % w})
+            m = std::max(m, lum[ry * w + rx]);
+        bound[y * w + x] = m;
+      }
   env.marginal.assign(h + 1, 0.0f);
   env.conditional.assign(h * (w + 1), 0.0f);
   std::vector<double> row_weight(h), texel_weight(w);
-  double weighted = 0.0;  // sum of luminance x solid angle
+  double weighted = 0.0;  // sum of luminance x solid angle (the map's own, whatever the filter)
   const double row_half_height = std::sin(0.5 * kPi / double(h));
   for (std::size_t y = 0; y < h; ++y) {
     const double sin_theta = std::sin(kPi * (double(y) + 0.5) / double(h));
-    double row = 0.0;
+    double row = 0.0, row_luminance = 0.0;
     for (std::size_t x = 0; x < w; ++x) {
-      texel_weight[x] = luminance(env.texels[y * w + x]) * sin_theta;
+      texel_weight[x] = bound[y * w + x] * sin_theta;
       row += texel_weight[x];
+      row_luminance += lum[y * w + x] * sin_theta;
     }
     row_weight[y] = row;
-    weighted += row * (2.0 * kPi / double(w)) * 2.0 * row_half_height;
+    weighted += row_luminance * (2.0 * kPi / double(w)) * 2.0 * row_half_height;
     write_cdf(texel_weight, env.conditional.data() + y * (w + 1), false);
   }
   write_cdf(row_weight, env.marginal.data(), true);

@@ -14,13 +14,20 @@
 
 namespace wp {
 
+// How escaped rays look the map up (--env-filter; kernels/environment.h): the nearest texel, or
+// bilinear interpolation between the four texel centres around the direction. The sampling tables
+// depend on it: bilinear tables give each texel the largest luminance of its 3 x 3 neighbourhood.
+enum class EnvFilter { kNearest, kBilinear };
+const char* env_filter_name(EnvFilter f);  // "nearest", "bilinear"
+
 struct EnvironmentMap {
   std::string source;
   int width = 0, height = 0;
   std::vector<glm::vec4> texels;  // linear RGB radiance, row by row from the top; w unused
   // Sampling tables in the layout kernels/environment.h expects (see there).
-  std::vector<float> marginal;     // per row
-  std::vector<float> conditional;  // per texel
+  std::vector<float> marginal;             // per row
+  std::vector<float> conditional;          // per texel
+  EnvFilter filter = EnvFilter::kNearest;  // the lookup the tables were built for
   // Mean radiance luminance over the sphere (solid-angle weighted), for light selection by power.
   double mean_luminance = 0.0;
 };
@@ -28,9 +35,10 @@ struct EnvironmentMap {
 // Loads an equirectangular map. Throws wp::Error naming the file when it is missing, unreadable,
 // of an unsupported format, malformed or truncated, larger than 2^28 texels, or holds non-finite or
 // negative values.
-EnvironmentMap load_environment(const std::string& path);
+EnvironmentMap load_environment(const std::string& path, EnvFilter filter = EnvFilter::kNearest);
 
-// Builds the sampling tables and mean_luminance from texels/width/height.
-void build_environment_tables(EnvironmentMap& env);
+// Builds the sampling tables for `filter` (and sets env.filter) and mean_luminance (the nearest
+// map's, whatever the filter: it only weighs light selection) from texels/width/height.
+void build_environment_tables(EnvironmentMap& env, EnvFilter filter = EnvFilter::kNearest);
 
 }  // namespace wp

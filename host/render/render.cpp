@@ -56,7 +56,7 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
     std::uint64_t h = kFnv1aOffset;
     for (const glm::vec4& t : s.environment->texels) h = fnv1a64(&t[0], 3 * sizeof(float), h);
     env = std::to_string(s.environment->width) + "x" + std::to_string(s.environment->height) + ":" +
-          hex64(h);
+          hex64(h) + ";env_filter=" + env_filter_name(s.env_filter);
   }
   std::ostringstream k;
   k << "scene=" << hex64(scene.digest) << ";env=" << env << ";width=" << s.width

@@ -114,7 +114,8 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
 
 // The render key: one line naming everything that changes the image, so that films merge only
 // with films of the same render (host/film/film.h). ';'-separated name=value fields: the scene's
-// digest (Scene::digest), the environment map's (FNV-1a 64 of its texels) or none, width, height,
+// digest (Scene::digest), the environment map's (FNV-1a 64 of its texels, then env_filter) or none,
+// width, height,
 // max_depth, rr_depth, seed, background, env_intensity, env_rotation, strategy, mis_heuristic,
 // light_select, sampler, camera, features, bvh_width, spatial_splits and the kernels' source
 // digest. Not in it, as they do not change the image: the sample range, wave and work-group sizes,

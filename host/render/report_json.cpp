@@ -42,6 +42,7 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
           {"wavepath:environment", s.environment ? s.environment->source : std::string("constant")},
           {"wavepath:env_intensity", num(s.env_intensity)},
           {"wavepath:env_rotation", num(s.env_rotation)},
+          {"wavepath:env_filter", env_filter_name(s.env_filter)},
           {"wavepath:device", r.device},
           {"wavepath:features", r.features},
           {"wavepath:nonfinite_samples", std::to_string(r.nonfinite_samples)},

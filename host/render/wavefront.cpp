@@ -43,6 +43,8 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
                                                                             : "2");
   if (s.aov) o += " -D WP_AOV=1";
   if (s.view.aperture > 0.0f) o += " -D WP_THIN_LENS=1";
+  // Only with a map and bilinear lookup, so that nearest programs stay as they were.
+  if (features.environment && s.env_filter == EnvFilter::kBilinear) o += " -D WP_ENV_BILINEAR=1";
   return o;
 }
 
@@ -93,7 +95,14 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
   // of it) and compiles every kernel again for each new one, seconds each time.
   local_size_ = settings.local_size ? settings.local_size : 64;
-  const EnvironmentMap* env = settings.environment.get();
+  // Tables built for the other filter (a map made with the default of build_environment_tables):
+  // a copy with tables for this one, kept in settings_ for the upload.
+  if (settings_.environment && settings_.environment->filter != settings_.env_filter) {
+    auto rebuilt = std::make_shared<EnvironmentMap>(*settings_.environment);
+    build_environment_tables(*rebuilt, settings_.env_filter);
+    settings_.environment = std::move(rebuilt);
+  }
+  const EnvironmentMap* env = settings_.environment.get();
   features_ =
       settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
   // Cache hints in the stages that read path state through a queue (kernels/features.h,

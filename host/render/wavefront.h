@@ -58,6 +58,9 @@ struct RenderSettings {
   std::shared_ptr<const EnvironmentMap> environment;  // optional
   float env_intensity = 1.0f;                         // scales the map
   float env_rotation = 0.0f;                          // degrees about +Y
+  // The map's lookup (--env-filter); a map whose tables were built for the other filter gets
+  // tables rebuilt for this one (Wavefront's constructor).
+  EnvFilter env_filter = EnvFilter::kBilinear;
   Strategy strategy = Strategy::kMis;
   MisHeuristic mis_heuristic = MisHeuristic::kPower;
   LightSelect light_select = LightSelect::kPower;
