@@ -296,7 +296,7 @@ double known_irradiance(const wp::EnvironmentMap& env, wp::EnvFilter filter, int
   std::vector<double> row(std::size_t(h), 0.0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      row[std::size_t(y)] += env.texels[std::size_t(y * w + x)][channel] / w;
+      row[std::size_t(y)] += env.texels[std::size_t(y * w + x)][channel] / double(w);
   const auto r_of = [&](double v) {
     if (filter == wp::EnvFilter::kNearest) return row[std::size_t(std::min(int(v * h), h - 1))];
     const double fy = v * h - 0.5, y0 = std::floor(fy), t = fy - y0;
