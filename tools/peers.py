@@ -90,8 +90,8 @@ without a camera is rendered by both from a copy with wavepath's framing camera 
              multiscatter) with subsurface weight 0; a material the importer marks as
              backface-culled (glTF doubleSided false) gets the Mix Shader with a Transparent BSDF
              on back faces described above. World: an Environment Texture of the map (colour
-             space Linear Rec.709, interpolation Closest: wavepath looks up the texel a direction
-             falls in) times --env-intensity, its direction turned by a Mapping node (type Point,
+             space Linear Rec.709, interpolation Linear, Blender's default: bilinear, as
+             wavepath's default --env-filter) times --env-intensity, its direction turned by a Mapping node (type Point,
              rotation about Z of -(90 + --env-rotation) degrees): the importer turns glTF's +Y
              up into Blender's +Z up, and Blender's equirectangular map has its centre at +X
              where wavepath's has it at glTF's -Z (Blender's +Y). Black world without --env. The
@@ -397,7 +397,7 @@ def _cycles_world(bpy, sc, scene):
         env = nt.nodes.new("ShaderNodeTexEnvironment")
         env.image = bpy.data.images.load(scene["env"])
         env.image.colorspace_settings.name = "Linear Rec.709"
-        env.interpolation = "Closest"  # wavepath: the texel the direction falls in
+        env.interpolation = "Linear"  # bilinear, as wavepath's default --env-filter
         env.projection = "EQUIRECTANGULAR"
         coord = nt.nodes.new("ShaderNodeTexCoord")
         mapping = nt.nodes.new("ShaderNodeMapping")
@@ -1060,7 +1060,8 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "default is multiscatter GGX), subsurface off, and back faces of materials that are not "
          "double-sided made transparent (wavepath culls them). %s"
          "The environment is the world's Environment Texture with the same intensity, "
-         "nearest-texel lookup (`Closest`, as wavepath) and the same orientation (a Mapping node "
+         "bilinear lookup (`Linear`, Blender's default, as wavepath's default `--env-filter`) "
+         "and the same orientation (a Mapping node "
          "turns Blender's equirectangular convention into wavepath's; checked by the background "
          "pixels below). One-pixel box filter, max bounces = max depth − 1 (Cycles counts "
          "bounces after the first hit), no clamping, no filter glossy, no adaptive sampling, no "
