@@ -13,6 +13,7 @@
 #include "host/film/film.h"
 #include "host/film/image_io.h"
 #include "host/render/render.h"
+#include "tests/device_test.h"
 #include "tests/cli_run.h"
 #include "tests/scene_factory.h"
 #include "tests/test_assets.h"
@@ -56,13 +57,7 @@ wp::RenderSettings aov_settings(int spp) {
   return st;
 }
 
-class Aov : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
-  static void TearDownTestSuite() { delete runtime_; }
-  static wp::ClRuntime* runtime_;
-};
-wp::ClRuntime* Aov::runtime_ = nullptr;
+class Aov : public wp::test::DeviceTest {};
 
 // Every sample of a pixel records the same values, so the means are those values up to the
 // film's fixed point (2^-32) and float rounding: 1e-6.

@@ -13,19 +13,11 @@
 #include "host/device/cl_runtime.h"
 #include "host/device/kernel_sources.h"
 #include "host/render/pipeline.h"
+#include "tests/device_test.h"
 
 namespace {
 
-class KernelSourcesOnDevice : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
-  static void TearDownTestSuite() {
-    delete runtime_;
-    runtime_ = nullptr;
-  }
-  static wp::ClRuntime* runtime_;
-};
-wp::ClRuntime* KernelSourcesOnDevice::runtime_ = nullptr;
+class KernelSourcesOnDevice : public wp::test::DeviceTest {};
 
 // Each stage's .cl alone, every feature on (features.h's defaults) and AOVs, so that every
 // #if branch a stage has is compiled: it builds, and its program holds one kernel, the stage's.

@@ -25,6 +25,7 @@
 #include "host/lights/light_table.h"
 #include "host/render/render.h"
 #include "host/device/scene_features.h"
+#include "tests/device_test.h"
 #include "tests/scene_factory.h"
 
 namespace {
@@ -32,21 +33,14 @@ namespace {
 using glm::dvec3;
 using glm::vec3;
 
-class LightTransport : public ::testing::Test {
+class LightTransport : public wp::test::DeviceTest {
  public:  // render is used by the free helpers below too
-  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
-  static void TearDownTestSuite() {
-    delete runtime_;
-    runtime_ = nullptr;
-  }
   static wp::Rendered render(const wp::Scene& s, const wp::RenderSettings& st) {
     wp::Rendered r = wp::render(*runtime_, s, st);
     EXPECT_EQ(r.report.nonfinite_samples, 0u) << "NaN/Inf reached the film";
     return r;
   }
-  static wp::ClRuntime* runtime_;
 };
-wp::ClRuntime* LightTransport::runtime_ = nullptr;
 
 struct ZStats {
   double mean_z2 = 0.0, worst = 0.0;

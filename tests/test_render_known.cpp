@@ -25,6 +25,7 @@
 #include "host/device/cl_runtime.h"
 #include "host/device/device_scene.h"
 #include "host/render/render.h"
+#include "tests/device_test.h"
 #include "tests/scene_factory.h"
 
 namespace {
@@ -32,16 +33,7 @@ namespace {
 using glm::dvec3;
 using glm::vec3;
 
-class RenderKnown : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
-  static void TearDownTestSuite() {
-    delete runtime_;
-    runtime_ = nullptr;
-  }
-  static wp::ClRuntime* runtime_;
-};
-wp::ClRuntime* RenderKnown::runtime_ = nullptr;
+class RenderKnown : public wp::test::DeviceTest {};
 
 constexpr int kWidth = 64, kHeight = 48, kSpp = 16;
 

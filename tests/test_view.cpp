@@ -25,6 +25,7 @@
 #include "host/render/render.h"
 #include "host/scene/view.h"
 #include "host/util/error.h"
+#include "tests/device_test.h"
 #include "tests/scene_factory.h"
 
 namespace {
@@ -166,16 +167,7 @@ TEST(View, ImpossibleViewsAreErrorsNamingTheOption) {
 
 // ---- device: renders of markers -----------------------------------------------------------------
 
-class ViewRender : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { runtime_ = new wp::ClRuntime(wp::select_device("")); }
-  static void TearDownTestSuite() {
-    delete runtime_;
-    runtime_ = nullptr;
-  }
-  static wp::ClRuntime* runtime_;
-};
-wp::ClRuntime* ViewRender::runtime_ = nullptr;
+class ViewRender : public wp::test::DeviceTest {};
 
 constexpr int kWidth = 64, kHeight = 48;
 
