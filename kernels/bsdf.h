@@ -94,6 +94,9 @@ typedef struct Surface {
   float metallic, roughness, ior, transmission;
   float specular; /* KHR_materials_specular specularFactor: scales the dielectric Fresnel term */
   uint flags;     /* WP_SURF_* */
+#if WP_FEATURE_TEXTURE_LOD
+  float curvature; /* of the surface across the triangle, on the side of wo (ray_cone.h) */
+#endif
   /* The material extensions, each present only in programs built with its feature. */
 #if WP_FEATURE_SPECULAR
   float3 specular_color; /* KHR_materials_specular colour: tints the dielectric F0 */

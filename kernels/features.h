@@ -26,6 +26,10 @@
 #ifndef WP_FEATURE_TEXTURES
 #define WP_FEATURE_TEXTURES 1 /* any material texture */
 #endif
+#ifndef WP_FEATURE_TEXTURE_LOD
+#define WP_FEATURE_TEXTURE_LOD 1 /* mip-mapped textures looked up through ray cones (ray_cone.h) \
+                                  */
+#endif
 #ifndef WP_FEATURE_NORMAL_MAPS
 #define WP_FEATURE_NORMAL_MAPS 1 /* tangent-space normal textures */
 #endif

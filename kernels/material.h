@@ -10,6 +10,7 @@
 #define WP_MATERIAL_H
 
 #include "bsdf.h"
+#include "ray_cone.h"
 #include "scene.h"
 #include "textures.h" /* unconditionally: the source expander includes each header once */
 
@@ -60,10 +61,10 @@ static inline void tangent_frame(const SceneView* scene, uint4 tv, float u, floa
 /* The normal of normal texture `tex` at the point, in the front side's frame: the tangent-space
  * normal (texel * 2 - 1, x and y times `scale`) in the tangent frame around n. */
 static inline float3 normal_mapped(const SceneView* scene, int tex, float scale, uint4 tv, float u,
-                                   float v, float4 uv, float3 n) {
+                                   float v, TexPoint tp, float3 n) {
   float3 t, b;
   tangent_frame(scene, tv, u, v, n, &t, &b);
-  float3 c = texture_sample(scene, tex, uv).xyz * 2.0f - 1.0f;
+  float3 c = texture_at(scene, tex, tp).xyz * 2.0f - 1.0f;
   c.xy *= scale;
   const float3 p = c.x * t + c.y * b + c.z * n;
   const float lp = length(p);
@@ -89,7 +90,7 @@ static inline float3 keep_reflection_above(float3 ns, float3 ng, float3 wo) {
 
 /* Base colour, metallic, roughness and transmission: factors x textures x vertex colour. */
 static inline void resolve_material(const SceneView* scene, __global const Material* m, uint4 tv,
-                                    float u, float v, float4 uv, Surface* s) {
+                                    float u, float v, TexPoint tp, Surface* s) {
   float3 color = m->base_color.xyz;
 #if WP_FEATURE_VERTEX_COLORS
   color *= interpolate3(scene->colors, tv, u, v);
@@ -104,15 +105,15 @@ static inline void resolve_material(const SceneView* scene, __global const Mater
   s->specular = m->specular.w; /* KHR_materials_specular factor */
 #if WP_FEATURE_TEXTURES
   const int4 tex = m->textures0;
-  if (tex.x >= 0) color *= texture_sample(scene, tex.x, uv).xyz;
+  if (tex.x >= 0) color *= texture_at(scene, tex.x, tp).xyz;
   if (tex.y >= 0) {
-    const float4 mr = texture_sample(scene, tex.y, uv); /* B: metallic, G: roughness */
+    const float4 mr = texture_at(scene, tex.y, tp); /* B: metallic, G: roughness */
     s->metallic *= mr.z;
     s->roughness *= mr.y;
   }
-  if (m->textures1.x >= 0) s->transmission *= texture_sample(scene, m->textures1.x, uv).x;
+  if (m->textures1.x >= 0) s->transmission *= texture_at(scene, m->textures1.x, tp).x;
 #else
-  (void)uv, (void)scene;
+  (void)tp, (void)scene;
 #endif
   s->color = color;
 }
@@ -125,11 +126,11 @@ static inline void resolve_material(const SceneView* scene, __global const Mater
 #if WP_BSDF_EXTENSIONS
 /* A texture's texel at the point, or 1 without the texture (or without textures in the
  * program): what multiplies a factor, as glTF specifies. */
-static inline float4 texel_or_one(const SceneView* scene, int tex, float4 uv) {
+static inline float4 texel_or_one(const SceneView* scene, int tex, TexPoint tp) {
 #if WP_FEATURE_TEXTURES
-  if (tex >= 0) return texture_sample(scene, tex, uv);
+  if (tex >= 0) return texture_at(scene, tex, tp);
 #else
-  (void)scene, (void)tex, (void)uv;
+  (void)scene, (void)tex, (void)tp;
 #endif
   return (float4)(1.0f);
 }
@@ -140,20 +141,20 @@ static inline float4 texel_or_one(const SceneView* scene, int tex, float4 uv) {
  * direction in the tangent frame, made perpendicular to ns; a strength of 0 where no direction
  * is left). */
 static inline void resolve_extensions(const SceneView* scene, __global const Material* m, uint4 tv,
-                                      float u, float v, float4 uv, float3 n_front, float3 wo,
+                                      float u, float v, TexPoint tp, float3 n_front, float3 wo,
                                       Surface* s) {
-  (void)scene, (void)tv, (void)u, (void)v, (void)uv, (void)n_front, (void)wo;
+  (void)scene, (void)tv, (void)u, (void)v, (void)tp, (void)n_front, (void)wo;
 #if WP_FEATURE_SPECULAR
-  s->specular *= texel_or_one(scene, m->textures1.y, uv).w;
-  s->specular_color = m->specular.xyz * texel_or_one(scene, m->textures1.z, uv).xyz;
+  s->specular *= texel_or_one(scene, m->textures1.y, tp).w;
+  s->specular_color = m->specular.xyz * texel_or_one(scene, m->textures1.z, tp).xyz;
 #endif
 #if WP_FEATURE_CLEARCOAT
-  s->clearcoat = m->clearcoat.x * texel_or_one(scene, m->textures1.w, uv).x;
-  s->clearcoat_roughness = m->clearcoat.y * texel_or_one(scene, m->textures2.x, uv).y;
+  s->clearcoat = m->clearcoat.x * texel_or_one(scene, m->textures1.w, tp).x;
+  s->clearcoat_roughness = m->clearcoat.y * texel_or_one(scene, m->textures2.x, tp).y;
   float3 nc = n_front;
 #if WP_FEATURE_TEXTURES
   const bool coat_mapped = m->textures2.y >= 0;
-  if (coat_mapped) nc = normal_mapped(scene, m->textures2.y, m->clearcoat.z, tv, u, v, uv, nc);
+  if (coat_mapped) nc = normal_mapped(scene, m->textures2.y, m->clearcoat.z, tv, u, v, tp, nc);
 #endif
   if (dot(nc, s->ng) < 0.0f) nc = -nc;
 #if WP_FEATURE_TEXTURES
@@ -162,16 +163,16 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
   s->nc = dot(nc, wo) > 1e-4f ? nc : s->ng;
 #endif
 #if WP_FEATURE_SHEEN
-  const float4 sheen_c = texel_or_one(scene, m->textures2.z, uv);
+  const float4 sheen_c = texel_or_one(scene, m->textures2.z, tp);
   s->sheen_color = m->sheen.xyz * sheen_c.xyz;
-  s->sheen_roughness = m->sheen.w * texel_or_one(scene, m->textures2.w, uv).w;
+  s->sheen_roughness = m->sheen.w * texel_or_one(scene, m->textures2.w, tp).w;
 #endif
 #if WP_FEATURE_ANISOTROPY
   float strength = m->anisotropy.x;
   float2 dir = m->anisotropy.yz; /* (cos, sin) of the rotation */
 #if WP_FEATURE_TEXTURES
   if (m->textures3.x >= 0) {
-    const float4 a = texture_sample(scene, m->textures3.x, uv);
+    const float4 a = texture_at(scene, m->textures3.x, tp);
     const float2 d = a.xy * 2.0f - 1.0f; /* rotated by the rotation */
     dir = (float2)(dir.x * d.x - dir.y * d.y, dir.y * d.x + dir.x * d.y);
     strength *= a.z;
@@ -188,18 +189,18 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
   }
 #endif
 #if WP_FEATURE_IRIDESCENCE
-  s->iridescence = m->iridescence.x * texel_or_one(scene, m->textures3.y, uv).x;
+  s->iridescence = m->iridescence.x * texel_or_one(scene, m->textures3.y, tp).x;
   s->iridescence_ior = m->iridescence.y;
   s->iridescence_thickness = m->iridescence.w;
 #if WP_FEATURE_TEXTURES
   if (m->textures3.z >= 0)
     s->iridescence_thickness =
-        mix(m->iridescence.z, m->iridescence.w, texture_sample(scene, m->textures3.z, uv).y);
+        mix(m->iridescence.z, m->iridescence.w, texture_at(scene, m->textures3.z, tp).y);
 #endif
 #endif
 #if WP_FEATURE_DIFFUSE_TRANSMISSION
-  s->diffuse_transmission = m->diffuse_transmission.w * texel_or_one(scene, m->textures3.w, uv).w;
-  s->dt_color = m->diffuse_transmission.xyz * texel_or_one(scene, m->textures4.x, uv).xyz;
+  s->diffuse_transmission = m->diffuse_transmission.w * texel_or_one(scene, m->textures3.w, tp).w;
+  s->dt_color = m->diffuse_transmission.xyz * texel_or_one(scene, m->textures4.x, tp).xyz;
 #endif
 #if WP_FEATURE_DISPERSION
   s->dispersion = m->extra.w;
@@ -208,11 +209,32 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
 }
 #endif
 
+/* The texture coordinates at barycentrics (u, v) of triangle tv and, with WP_FEATURE_TEXTURE_LOD,
+ * the footprint there of a ray cone `cone_width` across arriving at cos_theta to the triangle's
+ * plane (twice_area: |cross(p1 - p0, p2 - p0)|; ray_cone.h). */
+static inline TexPoint texture_point(const SceneView* scene, uint4 tv, float u, float v,
+                                     float cone_width, float cos_theta, float twice_area) {
+  TexPoint tp;
+#if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS || WP_BSDF_EXTENSIONS
+  tp.uv = interpolate4(scene->uvs, tv, u, v);
+#else
+  tp.uv = (float4)(0.0f);
+#endif
+#if WP_FEATURE_TEXTURE_LOD
+  tp.lod = footprint_lod(cone_width, cos_theta, twice_area, scene->uvs[tv.x], scene->uvs[tv.y],
+                         scene->uvs[tv.z]);
+#else
+  (void)cone_width, (void)cos_theta, (void)twice_area;
+#endif
+  return tp;
+}
+
 /* Geometry and material at a hit of a ray with direction ray_d on triangle tv at barycentrics
- * (u, v). *front tells whether the ray hit the front (counter-clockwise) side; both normals are
+ * (u, v), reached by a ray cone `cone_width` across there (ray_cone.h; 0: full-resolution
+ * textures). *front tells whether the ray hit the front (counter-clockwise) side; both normals are
  * turned to face the ray. */
 static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u, float v,
-                                      float3 ray_d, bool* front) {
+                                      float3 ray_d, float cone_width, bool* front) {
   __global const Material* m = scene->materials + tv.w;
   Surface s;
   const float3 p0 = scene->positions[tv.x].xyz;
@@ -225,16 +247,17 @@ static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u,
   s.ng = len > 0.0f ? n / len : -ray_d; /* a degenerate triangle faces the ray */
   *front = dot(s.ng, ray_d) < 0.0f;
   if (!*front) s.ng = -s.ng;
-#if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS || WP_BSDF_EXTENSIONS
-  const float4 uv = interpolate4(scene->uvs, tv, u, v);
-#else
-  const float4 uv = (float4)(0.0f);
+  const TexPoint tp = texture_point(scene, tv, u, v, cone_width, dot(s.ng, ray_d), len);
+#if WP_FEATURE_TEXTURE_LOD
+  s.curvature = triangle_curvature(p0, p1, p2, scene->normals[tv.x].xyz, scene->normals[tv.y].xyz,
+                                   scene->normals[tv.z].xyz);
+  if (!*front) s.curvature = -s.curvature; /* the normals point to the front side */
 #endif
   const float3 n_front = normalize(interpolate3(scene->normals, tv, u, v));
   s.ns = n_front;
 #if WP_FEATURE_NORMAL_MAPS
   if (m->textures0.z >= 0)
-    s.ns = normal_mapped(scene, m->textures0.z, m->extra.x, tv, u, v, uv, n_front);
+    s.ns = normal_mapped(scene, m->textures0.z, m->extra.x, tv, u, v, tp, n_front);
 #endif
   /* Computed on the front side's frame; turned, like the interpolated normal, to the side the
    * ray sees (for a back-side hit that mirrors the whole front-side frame). */
@@ -245,9 +268,9 @@ static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u,
   /* An interpolated normal can face away from the viewer near silhouettes; shading with it would
    * reflect into the surface. Fall back to the true normal there. */
   if (!(dot(s.ns, -ray_d) > 1e-4f)) s.ns = s.ng;
-  resolve_material(scene, m, tv, u, v, uv, &s);
+  resolve_material(scene, m, tv, u, v, tp, &s);
 #if WP_BSDF_EXTENSIONS
-  resolve_extensions(scene, m, tv, u, v, uv, n_front, -ray_d, &s);
+  resolve_extensions(scene, m, tv, u, v, tp, n_front, -ray_d, &s);
 #endif
   s.flags = *front ? WP_SURF_FRONT : 0u;
 #if WP_FEATURE_UNLIT

@@ -69,4 +69,51 @@ static inline Paths paths_bind(__global uchar* base, PathLayout layout) {
 #undef WP_PATH_LANE
 #undef WP_PATH_FIELD
 
+/* The halves of the flags and bounce words (shared/path_state.def). The low halves hold the flags
+ * and the bounce count (--max-depth stays below 2^16 - 1, so roulette's increment never carries
+ * into the high half); the high halves hold the ray cone (ray_cone.h) as bfloat16, the upper 16
+ * bits of a float rounded to nearest: 8 bits of precision (0.4%, 0.006 of a mip level) over
+ * float's whole range. Programs without WP_FEATURE_TEXTURE_LOD keep the high halves 0 and read
+ * and write the words whole. */
+#if WP_FEATURE_TEXTURE_LOD
+static inline uint bf16_from_float(float x) {
+  const uint b = as_uint(x);
+  return (b + 0x7fffu + ((b >> 16) & 1u)) >> 16; /* to nearest, ties to even; x finite */
+}
+static inline float bf16_to_float(uint h) {
+  return as_float(h << 16);
+}
+static inline uint low_half(uint word) {
+  return word & 0xffffu;
+}
+static inline uint with_low_half(uint word, uint low) {
+  return (word & 0xffff0000u) | low;
+}
+static inline float high_bf16(uint word) {
+  return bf16_to_float(word >> 16);
+}
+static inline uint with_high_bf16(uint word, float x) {
+  return (word & 0xffffu) | (bf16_from_float(x) << 16);
+}
+#else
+static inline uint low_half(uint word) {
+  return word;
+}
+static inline uint with_low_half(uint word, uint low) {
+  return (void)word, low;
+}
+#endif
+static inline uint path_bounce(Paths paths, uint slot) {
+  return low_half(path_bounce_word(paths, slot));
+}
+static inline void path_set_bounce(Paths paths, uint slot, uint bounce) {
+  path_set_bounce_word(paths, slot, with_low_half(path_bounce_word(paths, slot), bounce));
+}
+static inline uint path_flags(Paths paths, uint slot) {
+  return low_half(path_flags_word(paths, slot));
+}
+static inline void path_set_flags(Paths paths, uint slot, uint flags) {
+  path_set_flags_word(paths, slot, with_low_half(path_flags_word(paths, slot), flags));
+}
+
 #endif /* WP_PATH_STATE_H */

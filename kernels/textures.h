@@ -8,9 +8,12 @@
  * textures are decoded with the exact sRGB EOTF per texel before filtering, so filtering averages
  * linear values; alpha is always linear.
  *
- * No mipmaps: the minification filter is ignored. A path tracer jitters every sample over its
- * pixel, so the pixel's average over many samples supersamples the texture and minified textures
- * converge to their box-filtered footprint instead of aliasing (at the cost of noise at low spp).
+ * Minification: with WP_FEATURE_TEXTURE_LOD (--mipmaps on, the default, and a texture whose
+ * sampler's minFilter is a mip-map mode or unset) a texture is looked up at the level of detail of
+ * the path's ray cone (ray_cone.h), trilinearly in the host's mip chain (host/device/mipmap.cpp):
+ * a surface far away shows the mean of its texels instead of noise that only many samples average
+ * away. Without it the minification filter is ignored: the pixel's average over many jittered
+ * samples supersamples the texture (converging to the box-filtered footprint, noisily at low spp).
  */
 #ifndef WP_TEXTURES_H
 #define WP_TEXTURES_H
@@ -57,7 +60,25 @@ static inline float wrap_reduce(float u, uint mode) {
   return u - floor(u);
 }
 
-/* Texture `ref` at the vertex texture coordinates uv01 (xy: TEXCOORD_0, zw: TEXCOORD_1). */
+/* Bilinear lookup at texel-space position (x, y) of image (or mip level) img: the four texel
+ * centres around it, each wrapped. */
+static inline float4 texel_bilinear(__global const uint* texels, TextureImage img, float x, float y,
+                                    uint wrap_s, uint wrap_t, bool srgb) {
+  const int w = (int)img.width, h = (int)img.height;
+  const float fx = x - 0.5f, fy = y - 0.5f; /* relative to texel centres */
+  const float x0 = floor(fx), y0 = floor(fy);
+  const float ax = fx - x0, ay = fy - y0;
+  const int i0 = wrap_texel((int)x0, w, wrap_s), i1 = wrap_texel((int)x0 + 1, w, wrap_s);
+  const int j0 = wrap_texel((int)y0, h, wrap_t), j1 = wrap_texel((int)y0 + 1, h, wrap_t);
+  const float4 top =
+      mix(texel_fetch(texels, img, i0, j0, srgb), texel_fetch(texels, img, i1, j0, srgb), ax);
+  const float4 bottom =
+      mix(texel_fetch(texels, img, i0, j1, srgb), texel_fetch(texels, img, i1, j1, srgb), ax);
+  return mix(top, bottom, ay);
+}
+
+/* Texture `ref` at the vertex texture coordinates uv01 (xy: TEXCOORD_0, zw: TEXCOORD_1), at full
+ * resolution (level 0) with the sampler's magnification filter. */
 static inline float4 texture_sample(const SceneView* scene, int ref, float4 uv01) {
   __global const TextureRef* t = scene->textures + ref;
   const uint4 meta = t->meta;
@@ -74,16 +95,69 @@ static inline float4 texture_sample(const SceneView* scene, int ref, float4 uv01
     const int i = wrap_texel((int)floor(x), w, wrap_s), j = wrap_texel((int)floor(y), h, wrap_t);
     return texel_fetch(scene->texels, img, i, j, srgb);
   }
-  const float fx = x - 0.5f, fy = y - 0.5f; /* relative to texel centres */
-  const float x0 = floor(fx), y0 = floor(fy);
-  const float ax = fx - x0, ay = fy - y0;
-  const int i0 = wrap_texel((int)x0, w, wrap_s), i1 = wrap_texel((int)x0 + 1, w, wrap_s);
-  const int j0 = wrap_texel((int)y0, h, wrap_t), j1 = wrap_texel((int)y0 + 1, h, wrap_t);
-  const float4 top = mix(texel_fetch(scene->texels, img, i0, j0, srgb),
-                         texel_fetch(scene->texels, img, i1, j0, srgb), ax);
-  const float4 bottom = mix(texel_fetch(scene->texels, img, i0, j1, srgb),
-                            texel_fetch(scene->texels, img, i1, j1, srgb), ax);
-  return mix(top, bottom, ay);
+  return texel_bilinear(scene->texels, img, x, y, wrap_s, wrap_t, srgb);
+}
+
+/* A point's texture coordinates, and with WP_FEATURE_TEXTURE_LOD the log2 of its ray cone's
+ * footprint per coordinate set (ray_cone.h; -INFINITY: full resolution). */
+typedef struct TexPoint {
+  float4 uv; /* xy: TEXCOORD_0, zw: TEXCOORD_1 */
+#if WP_FEATURE_TEXTURE_LOD
+  float2 lod;
+#endif
+} TexPoint;
+
+#if WP_FEATURE_TEXTURE_LOD
+/* Mip level `level` of img (TextureImage.levels of them, level 0 the image;
+ * host/device/mipmap.cpp): each level halves the one before, rounding down, and follows it in the
+ * texel array. */
+static inline TextureImage mip_level(TextureImage img, uint level) {
+  for (uint k = 0u; k < level; ++k) {
+    img.offset += img.width * img.height;
+    img.width = max(img.width >> 1, 1u);
+    img.height = max(img.height >> 1, 1u);
+  }
+  return img;
+}
+
+/* Texture `ref` at a point seen through a ray cone: at its footprint's level lambda (the point's
+ * lod for the texture's coordinate set plus the texture's own term, TextureRef.meta.w), bilinear
+ * in the two levels around lambda and linear between them (trilinear); where lambda <= 0, or the
+ * texture has no mip-maps (meta.w = -INFINITY), texture_sample's full-resolution lookup. */
+static inline float4 texture_sample_lod(const SceneView* scene, int ref, float4 uv01, float2 lod) {
+  __global const TextureRef* t = scene->textures + ref;
+  const uint4 meta = t->meta;
+  const float lambda = (meta.z == 1u ? lod.y : lod.x) + as_float(meta.w);
+  const TextureImage img = scene->images[meta.x];
+  if (!(lambda > 0.0f) || img.levels < 2u) return texture_sample(scene, ref, uv01);
+  const float2 uv = meta.z == 1u ? uv01.zw : uv01.xy;
+  const float4 ru = t->transform_u, rv = t->transform_v;
+  const uint wrap_s = meta.y & 0xffu, wrap_t = (meta.y >> 8) & 0xffu;
+  const bool srgb = (meta.y & WP_TEX_SRGB) != 0u;
+  const float s = wrap_reduce(ru.x * uv.x + ru.y * uv.y + ru.z, wrap_s);
+  const float r = wrap_reduce(rv.x * uv.x + rv.y * uv.y + rv.z, wrap_t);
+  const float last = (float)(img.levels - 1u);
+  const float l = fmin(lambda, last);
+  const float l0 = floor(l);
+  const TextureImage a = mip_level(img, (uint)l0);
+  const float4 ca = texel_bilinear(scene->texels, a, s * (float)a.width, r * (float)a.height,
+                                   wrap_s, wrap_t, srgb);
+  if (l0 >= last) return ca;
+  const TextureImage b = mip_level(a, 1u);
+  const float4 cb = texel_bilinear(scene->texels, b, s * (float)b.width, r * (float)b.height,
+                                   wrap_s, wrap_t, srgb);
+  return mix(ca, cb, l - l0);
+}
+#endif
+
+/* Texture `ref` at point tp: through its ray cone with WP_FEATURE_TEXTURE_LOD, else at full
+ * resolution. */
+static inline float4 texture_at(const SceneView* scene, int ref, TexPoint tp) {
+#if WP_FEATURE_TEXTURE_LOD
+  return texture_sample_lod(scene, ref, tp.uv, tp.lod);
+#else
+  return texture_sample(scene, ref, tp.uv);
+#endif
 }
 
 #endif /* WP_TEXTURES_H */

@@ -12,7 +12,9 @@
 // of a false alarm is ~2e-5. Where the Monte Carlo error dominates, the mean of z^2 must also be
 // that of a chi-square variable with one degree of freedom: 1 +- 5 sqrt(2/N) (this catches a
 // wrong variance, i.e. correlated or non-uniform jitter, that a per-pixel bound would miss).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -25,6 +27,7 @@
 #include "host/device/cl_runtime.h"
 #include "host/device/device_scene.h"
 #include "host/render/render.h"
+#include "host/scene/srgb.h"
 #include "tests/device_test.h"
 #include "tests/scene_factory.h"
 
@@ -361,6 +364,116 @@ TEST_F(RenderKnown, EmptySceneShowsOnlyTheBackground) {
       for (int c = 0; c < 3; ++c)
         ASSERT_EQ(r.image.rgb[3 * p + c], background[c]) << "width " << width << " pixel " << p;
   }
+}
+
+// A 2 x 2 square in the plane z = 0 facing +z, textured with a 64 x 64 checkerboard of black and
+// white texels (sRGB colour, magnification NEAREST, REPEAT) repeated 8 times across: 256 texels
+// per unit. Unlit (the image is the texture itself) or Lambertian.
+wp::Scene checker_scene(bool unlit) {
+  wp::Scene s;
+  wp::Image img;
+  img.width = img.height = 64;
+  for (int j = 0; j < 64; ++j)
+    for (int i = 0; i < 64; ++i) {
+      const std::uint8_t v = (i + j) % 2 ? 255 : 0;
+      img.rgba.insert(img.rgba.end(), {v, v, v, 255});
+    }
+  s.images.push_back(img);
+  wp::TextureRef t;
+  t.image = 0;
+  t.srgb = true;
+  t.nearest = true;
+  s.textures.push_back(t);
+  wp::Material m = wp::test::diffuse_material(vec3(1.0f));
+  m.unlit = unlit;
+  m.specular = 0.0f;  // Lambert's BSDF alone: under a white sky its radiance is its albedo
+  m.base_color_texture = 0;
+  s.materials.push_back(m);
+  wp::test::add_quad(s, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, 0);
+  for (std::size_t v = 0; v < 4; ++v)
+    s.uv0[v] = 4.0f * glm::vec2(s.positions[v].x + 1.0f, 1.0f - s.positions[v].y);
+  wp::test::finish_bounds(s);
+  return s;
+}
+
+// The checkerboard seen from `distance` on its axis through a 0.5 rad field of view, 48 x 48.
+wp::RenderSettings checker_view(wp::Scene& s, float distance, bool mipmaps, int spp) {
+  s.cameras = {wp::test::look_at({0.1f, 0.05f, distance}, {0.1f, 0.05f, 0.0f}, 0.5f)};
+  wp::RenderSettings st;
+  st.width = st.height = 48;
+  st.spp = spp;
+  st.camera = 0;
+  st.mipmaps = mipmaps;
+  st.background = vec3(1.0f);
+  st.sampler = wp::Sampler::kIndependent;  // the standard errors below assume independent samples
+  return st;
+}
+
+// The mean of the checkerboard as its mip levels store it: every level from 1 on is exactly 0.5
+// in linear light (a box over whole 2 x 2 blocks), encoded as 8-bit sRGB (code 188) and decoded.
+double stored_half() {
+  return wp::srgb_to_linear(std::round(255.0 * wp::linear_to_srgb(0.5)) / 255.0);
+}
+
+// Seen from 2.93 units the board spans 1.5 units (384 texels) over 48 pixels: a pixel covers 8 x 8
+// texels, and each camera ray's cone picks level ~3. With mip-maps every sample is
+// the stored half (the unlit image is that constant within float rounding, 1e-6), variance 0;
+// without, each sample is the texel under its jittered point, 0 or 1 with probability 1/2: the
+// image converges to 0.5, and each pixel's estimate has variance 0.25 / spp, which the mean of the
+// renderer's per-pixel variance estimates over 2304 pixels matches within 10% (their own relative
+// spread: sqrt(2 / 15) / 48 = 0.8%). Every mean over the 2304 pixels lies within 5 of its standard
+// errors of its known value. Lit (Lambertian under a white sky: radiance = albedo a times the
+// lighting estimate L, E[L] = 1, independent of a), the variance without mip-maps is E[a^2] E[L^2]
+// - E[a]^2 and with them a_h^2 (E[L^2] - 1), a_h the stored half: their difference is at least
+// var(a) = 0.25 per sample (the texture's share, which mip-maps remove), checked with 10% slack;
+// the ratio is printed (docs/usage.md quotes it).
+TEST_F(RenderKnown, DistantCheckerboardShowsItsMeanWithMipmaps) {
+  const double half = stored_half();
+  const auto mean_of = [](const wp::ImageRgb& im) {
+    double sum = 0.0;
+    for (const float v : im.rgb) sum += v;
+    return sum / double(im.rgb.size());
+  };
+  for (const bool unlit : {true, false}) {
+    SCOPED_TRACE(unlit ? "unlit" : "lambertian");
+    wp::Scene s = checker_scene(unlit);
+    const wp::Rendered on = wp::render(*runtime_, s, checker_view(s, 2.93f, true, 16));
+    const wp::Rendered off = wp::render(*runtime_, s, checker_view(s, 2.93f, false, 16));
+    EXPECT_EQ(on.report.nonfinite_samples + off.report.nonfinite_samples, 0u);
+    const double var_on = mean_of(on.variance), var_off = mean_of(off.variance);
+    const double n = double(off.image.rgb.size());
+    // The standard error of a mean over pixels whose estimates each have variance var / 1.
+    EXPECT_NEAR(mean_of(off.image), 0.5, 5.0 * std::sqrt(var_off / n));
+    const double texture_share = 0.25 / 16.0;
+    if (unlit) {
+      for (const float v : on.image.rgb) ASSERT_NEAR(v, half, 1e-6);
+      EXPECT_EQ(var_on, 0.0);
+      EXPECT_NEAR(var_off, texture_share, 0.1 * texture_share);
+    } else {
+      EXPECT_NEAR(mean_of(on.image), half, 5.0 * std::sqrt(var_on / n));
+      EXPECT_GT(var_off - var_on, 0.9 * texture_share);
+      std::printf(
+          "checkerboard at 8 texels per pixel, Lambertian, 16 spp: pixel variance "
+          "%.3g with mip-maps, %.3g without (%.0fx)\n",
+          var_on, var_off, var_off / var_on);
+    }
+  }
+}
+
+// Seen from 0.1 units the board spans 0.051 units (13 texels) over 48 pixels: magnified, each
+// ray's level is below 0 (about -1.9), so mip-mapped lookups are the full-resolution ones: the
+// same image bit for bit as without mip-maps, and the checks are sharp (NEAREST): pixels inside a
+// texel are exactly 0 or 1.
+TEST_F(RenderKnown, NearCheckerboardStaysSharpWithMipmaps) {
+  wp::Scene s = checker_scene(true);
+  const wp::Rendered on = wp::render(*runtime_, s, checker_view(s, 0.1f, true, 4));
+  const wp::Rendered off = wp::render(*runtime_, s, checker_view(s, 0.1f, false, 4));
+  ASSERT_EQ(on.image.rgb.size(), off.image.rgb.size());
+  for (std::size_t i = 0; i < on.image.rgb.size(); ++i)
+    ASSERT_EQ(on.image.rgb[i], off.image.rgb[i]) << "value " << i;
+  const auto [lo, hi] = std::minmax_element(on.image.rgb.begin(), on.image.rgb.end());
+  EXPECT_EQ(*lo, 0.0f);
+  EXPECT_EQ(*hi, 1.0f);
 }
 
 // A small closed scene with every kind of randomness: diffuse, glossy and mirror surfaces, a

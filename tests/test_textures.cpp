@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
@@ -25,6 +26,8 @@
 #include "bvh/bvh.h"
 #include "host/device/device_scene.h"
 #include "host/lights/light_table.h"
+#include "host/scene/mipmap.h"
+#include "host/scene/srgb.h"
 #include "tests/kernel_harness.h"
 
 namespace {
@@ -131,10 +134,11 @@ glm::dvec2 transformed(const wp::TextureRef& t, glm::vec4 uv01) {
           t.row_v.x * uv.x + t.row_v.y * uv.y + double(t.row_v.z)};
 }
 
-Rgba reference_sample(const wp::Scene& s, const wp::TextureRef& t, glm::vec4 uv01) {
-  const wp::Image& img = s.images[std::size_t(t.image)];
+// Texture t at uv01 as if its image were `img` (a mip level of it, for the trilinear references).
+Rgba reference_sample_image(const wp::Image& img, const wp::TextureRef& t, glm::vec4 uv01,
+                            bool nearest) {
   const glm::dvec2 p = transformed(t, uv01) * glm::dvec2(img.width, img.height);
-  if (t.nearest)
+  if (nearest)
     return texel(img, wrap_index(std::llround(std::floor(p.x)), img.width, t.wrap_s),
                  wrap_index(std::llround(std::floor(p.y)), img.height, t.wrap_t), t.srgb);
   const glm::dvec2 q = p - 0.5, q0 = glm::floor(q), a = q - q0;
@@ -148,6 +152,10 @@ Rgba reference_sample(const wp::Scene& s, const wp::TextureRef& t, glm::vec4 uv0
       for (int k = 0; k < 4; ++k) out[k] += w * c[k];
     }
   return out;
+}
+
+Rgba reference_sample(const wp::Scene& s, const wp::TextureRef& t, glm::vec4 uv01) {
+  return reference_sample_image(s.images[std::size_t(t.image)], t, uv01, t.nearest);
 }
 
 // Bound on the device's error in the texel-space position (x, y), from its float arithmetic:
@@ -186,6 +194,24 @@ std::vector<float4> sample(const wp::SceneBuffers& d, const std::vector<int>& re
 // ---------------------------------------------------------------------------------------------
 // texture_sample
 
+struct Transform {
+  glm::vec3 u, v;
+  int texcoord;
+};
+
+// A texture of each of s's images for every wrap pair, magnification filter, encoding and
+// transform.
+void add_every_sampler(wp::Scene& s, const std::vector<Transform>& transforms) {
+  const wp::Wrap wraps[] = {wp::Wrap::kRepeat, wp::Wrap::kClampToEdge, wp::Wrap::kMirroredRepeat};
+  for (int image = 0; image < int(s.images.size()); ++image)
+    for (const wp::Wrap ws : wraps)
+      for (const wp::Wrap wt : wraps)
+        for (const bool nearest : {false, true})
+          for (const bool srgb : {false, true})
+            for (const Transform& x : transforms)
+              s.textures.push_back({image, ws, wt, nearest, srgb, x.texcoord, x.u, x.v});
+}
+
 // Every wrap pair, both filters, both encodings and three transforms (identity; a general affine
 // map; another on TEXCOORD_1) on three images (7x5, 1x1, 2x3), at uvs in [-2, 3] and, for half of
 // them, in [-100, 100].
@@ -193,21 +219,9 @@ TEST(TextureSample, MatchesReference) {
   std::mt19937 rng(11);
   wp::Scene s;
   s.images = {random_image(7, 5, rng), random_image(1, 1, rng), random_image(2, 3, rng)};
-  struct Transform {
-    glm::vec3 u, v;
-    int texcoord;
-  };
-  const Transform transforms[] = {{{1, 0, 0}, {0, 1, 0}, 0},
-                                  {{0.8f, -1.3f, 0.25f}, {1.1f, 0.6f, -0.4f}, 0},
-                                  {{-2.5f, 0.3f, 1.5f}, {0.2f, 3.0f, 0.75f}, 1}};
-  const wp::Wrap wraps[] = {wp::Wrap::kRepeat, wp::Wrap::kClampToEdge, wp::Wrap::kMirroredRepeat};
-  for (int image = 0; image < 3; ++image)
-    for (const wp::Wrap ws : wraps)
-      for (const wp::Wrap wt : wraps)
-        for (const bool nearest : {false, true})
-          for (const bool srgb : {false, true})
-            for (const Transform& x : transforms)
-              s.textures.push_back({image, ws, wt, nearest, srgb, x.texcoord, x.u, x.v});
+  add_every_sampler(s, {{{1, 0, 0}, {0, 1, 0}, 0},
+                        {{0.8f, -1.3f, 0.25f}, {1.1f, 0.6f, -0.4f}, 0},
+                        {{-2.5f, 0.3f, 1.5f}, {0.2f, 3.0f, 0.75f}, 1}});
 
   constexpr int kPerRef = 600;
   std::uniform_real_distribution<float> near_range(-2.0f, 3.0f), far_range(-100.0f, 100.0f);
@@ -554,6 +568,344 @@ TEST(Material, NormalMapKeepsReflectionAboveSurface) {
   EXPECT_LT(std::abs(ns.x), 0.005);  // the tilt stays in the y-z plane, bent toward +z
   EXPECT_GT(ns.y, 0.0);
   EXPECT_LT(ns.y, mapped({128, 218, 218}, 1, 1).y);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mip chains (host/scene/mipmap.cpp) and lookups through them (kernels/textures.h)
+
+// Level k of `image` as an Image, from mip_chain's output (level 0: the image).
+wp::Image mip_image(const wp::Image& image, const std::vector<std::uint8_t>& chain, int level) {
+  if (level == 0) return image;
+  std::size_t offset = 0;
+  for (int k = 1; k < level; ++k)
+    offset += 4 * std::size_t(wp::mip_size(image.width, k)) * wp::mip_size(image.height, k);
+  const int w = wp::mip_size(image.width, level), h = wp::mip_size(image.height, level);
+  const auto first = chain.begin() + std::ptrdiff_t(offset);
+  return image_of(w, h, std::vector<std::uint8_t>(first, first + 4 * std::ptrdiff_t(w) * h));
+}
+
+// The box filter of level 0 over texel (i, j) of level k, computed directly in double: the mean
+// of the piecewise-constant image over [i W / w_k, (i + 1) W / w_k) x [j H / h_k, (j + 1) H / h_k),
+// each channel decoded first (sRGB colour: the EOTF; alpha linear).
+Rgba box_of_level0(const wp::Image& img, int level, int i, int j, bool srgb) {
+  const int w = wp::mip_size(img.width, level), h = wp::mip_size(img.height, level);
+  const double x0 = double(i) * img.width / w, x1 = double(i + 1) * img.width / w;
+  const double y0 = double(j) * img.height / h, y1 = double(j + 1) * img.height / h;
+  Rgba sum{};
+  for (int y = int(std::floor(y0)); y < int(std::ceil(y1)); ++y)
+    for (int x = int(std::floor(x0)); x < int(std::ceil(x1)); ++x) {
+      const double cover = (std::min(x1, x + 1.0) - std::max(x0, double(x))) *
+                           (std::min(y1, y + 1.0) - std::max(y0, double(y)));
+      const Rgba c = texel(img, x, y, srgb);
+      for (int k = 0; k < 4; ++k) sum[k] += cover * c[k];
+    }
+  for (double& c : sum) c /= (x1 - x0) * (y1 - y0);
+  return sum;
+}
+
+// Every texel of every level, for odd, even, square and strip sizes, colour and data: each is the
+// 8-bit encoding, rounded to nearest, of the box filter of level 0 over its footprint, computed
+// here in double from level 0. The chain is made in float (each level from the previous one,
+// never from its 8-bit copy), so its value before rounding is within a few float ulps (far below
+// 1e-4 of a code) of the exact box: the stored code is within 0.5 + 1e-4 of 255 x exact, which
+// leaves it a choice only at ties (common: the mean of two or four codes often ends in .5). Also:
+// the number of levels, and the third of the image's texels the chain adds at most.
+TEST(MipChain, EachLevelIsTheBoxFilterOfLevelZero) {
+  std::mt19937 rng(5);
+  const std::pair<int, int> sizes[] = {{16, 16}, {13, 7}, {7, 13}, {6, 10}, {5, 5},
+                                       {33, 2},  {2, 33}, {1, 9},  {3, 1},  {64, 17}};
+  std::size_t checked = 0, ties = 0;
+  for (const auto& [w, h] : sizes)
+    for (const bool srgb : {false, true}) {
+      const wp::Image img = random_image(w, h, rng);
+      const std::vector<std::uint8_t> chain = wp::mip_chain(img, srgb);
+      const int levels = wp::mip_levels(w, h);
+      EXPECT_EQ(levels, 1 + int(std::floor(std::log2(std::min(w, h))))) << w << "x" << h;
+      EXPECT_EQ(wp::mip_size(std::min(w, h), levels - 1), 1);
+      std::size_t expected_bytes = 0;
+      for (int k = 1; k < levels; ++k)
+        expected_bytes += 4 * std::size_t(wp::mip_size(w, k)) * wp::mip_size(h, k);
+      ASSERT_EQ(chain.size(), expected_bytes) << w << "x" << h;
+      EXPECT_LE(3 * chain.size(), img.rgba.size()) << "more than a third added, " << w << "x" << h;
+      for (int k = 1; k < levels; ++k) {
+        const wp::Image level = mip_image(img, chain, k);
+        for (int j = 0; j < level.height; ++j)
+          for (int i = 0; i < level.width; ++i) {
+            const Rgba want = box_of_level0(img, k, i, j, srgb);
+            for (int c = 0; c < 4; ++c) {
+              const double exact = 255.0 * (srgb && c < 3 ? wp::linear_to_srgb(want[c]) : want[c]);
+              const int got = level.rgba[4 * (std::size_t(j) * level.width + i) + c];
+              ++checked;
+              ties += got != int(std::lround(exact));
+              if (std::abs(got - exact) > 0.5 + 1e-4)
+                ADD_FAILURE() << w << "x" << h << (srgb ? " srgb" : "") << " level " << k
+                              << " texel (" << i << ", " << j << ") channel " << c << ": " << got
+                              << " vs " << exact;
+            }
+          }
+      }
+    }
+  EXPECT_GT(checked, 4000u);
+  std::printf("%zu codes checked, %zu ties rounded the other way\n", checked, ties);
+}
+
+wp::SceneBuffers upload_mipmapped(const wp::Scene& s, const wp::dev::Camera& camera = {}) {
+  const wp::LightTable lights;
+  wp::SceneExtras extras;
+  extras.lights = &lights;
+  extras.mipmaps = true;
+  extras.camera = camera;
+  const wp::PackedScene p = wp::pack_scene(s, wp::bvh::Bvh{}, extras);
+  if (p.buffers.size() != 1) throw std::logic_error("test scene split over several buffers");
+  return wp::upload_scene(harness().runtime().context(), p);
+}
+
+// The texture's own term of its level (device_scene.cpp's lod_term), as the device adds it: in
+// float.
+float lod_term(const wp::Image& img, const wp::TextureRef& t) {
+  const double det = double(t.row_u.x) * t.row_v.y - double(t.row_u.y) * t.row_v.x;
+  return static_cast<float>(0.5 * std::log2(double(img.width) * img.height * std::abs(det)));
+}
+
+// texture_sample_lod against a trilinear reference on the host's levels (whose filtering the test
+// above checks): OpenGL's rule, the magnification filter at level 0 where lambda <= 0, else
+// bilinear in levels floor(lambda) and floor(lambda) + 1 mixed by the fraction (the last level
+// alone past it). Every wrap pair, both magnification filters, both encodings, a transform with
+// an area scale, on odd and even sizes; footprints swept densely around 0 (the switch between the
+// filters) and each integer level (the switch between level pairs), and past the last level.
+// lambda is formed in float as the device forms it (footprint + the texture's term), so both
+// sides pick the same levels. Tolerance: texture_bound's at level 0 (the coarser levels' position
+// errors are smaller), plus 1e-6 for the mix.
+TEST(TextureSample, LevelsMatchTrilinearReference) {
+  std::mt19937 rng(17);
+  wp::Scene s;
+  s.images = {random_image(13, 7, rng), random_image(8, 8, rng)};
+  add_every_sampler(s, {{{0.8f, -1.3f, 0.25f}, {1.1f, 0.6f, -0.4f}, 0}});
+  std::vector<float> footprints;
+  for (const float l : {0.0f, 1.0f, 2.0f, 3.0f})
+    for (const float e : {-0.01f, -1e-4f, 0.0f, 1e-4f, 0.01f, 0.25f, 0.5f, 0.75f})
+      footprints.push_back(l + e);
+  footprints.insert(footprints.end(), {-3.0f, 4.5f, 9.0f});
+
+  std::vector<int> refs;
+  std::vector<float4> uvs;
+  std::vector<float> lods;
+  std::uniform_real_distribution<float> range(-3.0f, 4.0f);
+  for (std::size_t r = 0; r < s.textures.size(); ++r) {
+    const wp::Image& img = s.images[std::size_t(s.textures[r].image)];
+    const float term = lod_term(img, s.textures[r]);
+    for (const float lambda : footprints)
+      for (int k = 0; k < 12; ++k) {
+        refs.push_back(int(r));
+        uvs.push_back({range(rng), range(rng), range(rng), range(rng)});
+        lods.push_back(lambda - term); /* the footprint that gives level lambda */
+      }
+  }
+  auto& h = harness();
+  const cl::Buffer rb = h.buffer(refs), ub = h.buffer(uvs), lb = h.buffer(lods);
+  const cl::Buffer out = h.buffer<float4>(uvs.size());
+  const wp::SceneBuffers scene = upload_mipmapped(s);
+  h.run("sample_textures_lod", uvs.size(), scene, rb, ub, lb, cl_uint(uvs.size()), out);
+  const std::vector<float4> got = h.read<float4>(out, uvs.size());
+
+  // Each image is filtered as colour, since a texture uses it as colour (device_scene.cpp).
+  std::vector<std::vector<std::uint8_t>> chains;
+  for (const wp::Image& img : s.images) chains.push_back(wp::mip_chain(img, true));
+  std::size_t failures = 0, skipped = 0;
+  for (std::size_t i = 0; i < uvs.size(); ++i) {
+    const wp::TextureRef& t = s.textures[std::size_t(refs[i])];
+    const wp::Image& img = s.images[std::size_t(t.image)];
+    const std::vector<std::uint8_t>& chain = chains[std::size_t(t.image)];
+    const float lambda = lods[i] + lod_term(img, t);
+    const glm::vec4 uv(uvs[i].x, uvs[i].y, uvs[i].z, uvs[i].w);
+    const glm::dvec2 bound = position_bound(s, t, uv);
+    Rgba want;
+    if (!(lambda > 0.0f)) {
+      if (t.nearest && near_border(transformed(t, uv) * glm::dvec2(img.width, img.height), bound)) {
+        ++skipped;
+        continue;
+      }
+      want = reference_sample_image(img, t, uv, t.nearest);
+    } else {
+      const int last = wp::mip_levels(img.width, img.height) - 1;
+      const float l = std::min(lambda, float(last));
+      const int l0 = int(std::floor(l));
+      want = reference_sample_image(mip_image(img, chain, l0), t, uv, false);
+      if (l0 < last) {
+        const Rgba b = reference_sample_image(mip_image(img, chain, l0 + 1), t, uv, false);
+        for (int c = 0; c < 4; ++c) want[c] += double(l - float(l0)) * (b[c] - want[c]);
+      }
+    }
+    const float* g = &got[i].x;
+    const double tol = texture_bound(bound, false) + 1e-6;
+    for (int c = 0; c < 4; ++c) {
+      if (std::abs(g[c] - want[c]) <= tol) continue;
+      if (++failures <= 10)
+        ADD_FAILURE() << "ref " << refs[i] << " lambda " << lambda << " channel " << c << ": "
+                      << g[c] << " vs " << want[c] << " (tolerance " << tol << ")";
+      break;
+    }
+  }
+  EXPECT_EQ(failures, 0u) << "of " << uvs.size() << " lookups";
+  EXPECT_LT(skipped, uvs.size() / 100);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ray cones (kernels/ray_cone.h)
+
+// The level a camera ray's cone picks on a plane at a known distance and angle, against the
+// analytic footprint: a pinhole's cone spreads by the pixel's angle g = 2 tan(yfov / 2) / height,
+// so at distance t along the ray it is g t across, and g t / cos on a plane the ray meets at
+// angle theta to its normal; a texture of W x H texels spread over the plane with texel density
+// sqrt(W H |det T| A_uv / A_world) per unit length sees that footprint as log2 of (its length x
+// the density) texels: lambda. An orthographic camera's cone is the pixel's height 2 ymag /
+// height at any distance. Checked for several pixels of tilted views on both coordinate sets
+// (TEXCOORD_1 of the square covers twice the area of TEXCOORD_0) with a scaling transform;
+// tolerance 1e-4 (float log2 and the cone's arithmetic: relative errors of a few 1e-7).
+TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
+  wp::Scene s;
+  wp::Material m;
+  m.base_color_texture =
+      add_texture(s, image_of(64, 32, std::vector<std::uint8_t>(64 * 32 * 4)), true, false);
+  s.textures.push_back(s.textures[0]);
+  s.textures[1].texcoord = 1;
+  s.textures[1].row_u = {3.0f, 0.5f, 0.0f};
+  s.textures[1].row_v = {0.0f, 0.5f, 0.2f};
+  s.materials.push_back(m);
+  add_square(s, 0);
+  constexpr int kHeight = 120;
+  struct View {
+    glm::dvec3 eye, target;
+    bool ortho;
+  };
+  const View views[] = {{{0.5, 0.5, 3.0}, {0.5, 0.5, 0.0}, false},
+                        {{-1.5, 0.3, 1.2}, {0.6, 0.5, 0.0}, false},
+                        {{0.5, -4.0, 0.7}, {0.5, 0.6, 0.0}, false},
+                        {{2.0, 1.5, 2.5}, {0.4, 0.4, 0.0}, true}};
+  for (const View& v : views) {
+    wp::Camera cam;
+    cam.position = glm::vec3(v.eye);
+    cam.forward = glm::vec3(glm::normalize(v.target - v.eye));
+    cam.up = std::abs(cam.forward.z) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
+    cam.yfov = 0.4f;
+    cam.type = v.ortho ? wp::CameraType::kOrthographic : wp::CameraType::kPerspective;
+    cam.ymag = 0.4f;
+    const wp::dev::Camera dc = wp::device_camera(cam, 160, kHeight);
+    std::vector<float4> queries, rays;
+    std::vector<double> want;
+    for (const glm::dvec2 ndc :
+         {glm::dvec2(0, 0), glm::dvec2(0.15, -0.1), glm::dvec2(-0.1, 0.05)}) {
+      const glm::dvec3 fwd(dc.forward.x, dc.forward.y, dc.forward.z);
+      const glm::dvec3 plane = ndc.x * glm::dvec3(dc.right.x, dc.right.y, dc.right.z) +
+                               ndc.y * glm::dvec3(dc.up.x, dc.up.y, dc.up.z);
+      const glm::dvec3 o = v.ortho ? v.eye + plane : v.eye;
+      const glm::dvec3 d = v.ortho ? fwd : glm::normalize(fwd + plane);
+      const double t = -o.z / d.z;
+      const glm::dvec3 p = o + t * d;
+      ASSERT_TRUE(p.x > 0 && p.x < 1 && p.y > 0 && p.y < 1) << "the ray misses the square";
+      // Triangle 0 holds x >= y at barycentrics (x - y, y); triangle 1, (0, 2, 3), the rest at
+      // (x, y - x).
+      const bool first = p.x >= p.y;
+      const glm::dvec2 bary = first ? glm::dvec2(p.x - p.y, p.y) : glm::dvec2(p.x, p.y - p.x);
+      const double length =
+          v.ortho ? 2.0 * 0.4 / kHeight : 2.0 * std::tan(0.5 * double(cam.yfov)) / kHeight * t;
+      const double across = length / std::abs(d.z);
+      for (std::uint32_t ref = 0; ref < 2; ++ref) {
+        const wp::TextureRef& tr = s.textures[ref];
+        const double det = double(tr.row_u.x) * tr.row_v.y - double(tr.row_u.y) * tr.row_v.x;
+        const double uv_area = ref == 1 ? 2.0 : 1.0;  // per unit area of the square
+        want.push_back(std::log2(across * std::sqrt(64.0 * 32.0 * std::abs(det) * uv_area)));
+        std::uint32_t tri = first ? 0u : 1u;
+        float4 q;
+        std::memcpy(&q.x, &tri, 4);
+        std::memcpy(&q.y, &ref, 4);
+        q.z = float(bary.x);
+        q.w = float(bary.y);
+        queries.push_back(q);
+        rays.push_back({float(d.x), float(d.y), float(d.z), float(t)});
+      }
+    }
+    auto& h = harness();
+    const cl::Buffer qb = h.buffer(queries), rb = h.buffer(rays);
+    const cl::Buffer out = h.buffer<float4>(queries.size());
+    h.run("camera_ray_levels", queries.size(), upload_mipmapped(s, dc), qb, rb, cl_uint(kHeight),
+          cl_uint(queries.size()), out);
+    const std::vector<float4> got = h.read<float4>(out, queries.size());
+    for (std::size_t i = 0; i < got.size(); ++i)
+      EXPECT_NEAR(got[i].x, want[i], 1e-4)
+          << "view from (" << v.eye.x << ", " << v.eye.y << ", " << v.eye.z << ") query " << i;
+  }
+}
+
+// The cone through bounces as the stages carry it, against the ray-cone recurrence in double: at
+// a hit at distance t the width grows by spread x t; leaving it, the spread grows by 2 k |width|
+// (curvature k) and, for a sample that is not a delta lobe, by 2 / sqrt(pi pdf), the full angle of
+// the cone of solid angle 1 / pdf, at most pi: 2 rad for a Lambertian sample at normal incidence
+// (pdf 1/pi), pi for one at cos 0.25.
+// Width and spread pass through the path state's bfloat16 halves between bounces (8 significant
+// bits: 2^-9 relative per rounding, a few roundings per value: 1% relative). The footprint, and so
+// the level, grows at every rough bounce; a mirror (pdf 0) on a flat surface adds no spread.
+TEST(RayCone, GrowsAtEachRoughBounce) {
+  const double pixel = 2.0 * std::tan(0.3) / 120.0;
+  // (t, curvature, pdf): Lambertian at normal incidence, glossy, a mirror on a flat surface, a
+  // mirror on a sphere of radius 2 seen from outside, Lambertian at cos 0.25.
+  const std::vector<float4> bounces = {{2.0f, 0.0f, float(1.0 / M_PI), 0.0f},
+                                       {1.5f, 0.0f, 40.0f, 0.0f},
+                                       {0.5f, 0.0f, 0.0f, 0.0f},
+                                       {0.7f, 0.5f, 0.0f, 0.0f},
+                                       {1.0f, 0.0f, float(0.25 / M_PI), 0.0f}};
+  auto& h = harness();
+  const cl::Buffer b = h.buffer(bounces), out = h.buffer<float4>(bounces.size());
+  h.run("cone_bounces", 1, cl_float2{{0.0f, float(pixel)}}, b, cl_uint(bounces.size()), out);
+  const std::vector<float4> got = h.read<float4>(out, bounces.size());
+  double width = 0.0, spread = pixel;
+  for (std::size_t i = 0; i < bounces.size(); ++i) {
+    const float4& x = bounces[i];
+    width += spread * x.x;
+    spread +=
+        2.0 * x.y * std::abs(width) + (x.z > 0 ? std::min(2.0 / std::sqrt(M_PI * x.z), M_PI) : 0.0);
+    EXPECT_NEAR(got[i].x, width, 0.01 * width) << "bounce " << i;
+    EXPECT_NEAR(got[i].y, spread, 0.01 * spread) << "bounce " << i;
+    if (i > 0) {
+      EXPECT_GT(got[i].x, got[i - 1].x) << "the footprint grows at bounce " << i;
+    }
+  }
+  EXPECT_NEAR(got[0].y - pixel, 2.0, 0.02) << "a Lambertian sample at normal incidence";
+  EXPECT_EQ(got[2].y, got[1].y) << "a flat mirror adds no spread";
+  EXPECT_GT(got[3].y, got[2].y) << "a convex mirror spreads the cone";
+}
+
+// triangle_curvature: 1/R for any triangle of points on a sphere of radius R with its radial
+// normals (dn . dp / |dp|^2 = (dp / R) . dp / |dp|^2 exactly), -1/R with the normals inward (the
+// sphere seen from inside), 0 for a flat triangle; within float rounding (1e-5 relative).
+TEST(RayCone, CurvatureOfSphereAndPlane) {
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  std::vector<float4> tris;
+  std::vector<double> want;
+  for (int k = 0; k < 60; ++k) {
+    const float r = 0.1f + 0.2f * float(k);
+    const glm::vec3 c(g(rng), g(rng), g(rng));
+    glm::vec3 n[3];
+    for (glm::vec3& x : n) {
+      x = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)) * 0.2f + glm::vec3(0, 0, 1));
+    }
+    const float sign = k % 2 ? -1.0f : 1.0f;
+    for (const glm::vec3& x : n) tris.push_back({c.x + r * x.x, c.y + r * x.y, c.z + r * x.z, 0});
+    for (const glm::vec3& x : n) tris.push_back({sign * x.x, sign * x.y, sign * x.z, 0});
+    want.push_back(sign / r);
+  }
+  for (int k = 0; k < 10; ++k) {  // flat, with one normal
+    for (int v = 0; v < 3; ++v) tris.push_back({g(rng), g(rng), 0.0f, 0});
+    for (int v = 0; v < 3; ++v) tris.push_back({0, 0, 1, 0});
+    want.push_back(0.0);
+  }
+  auto& h = harness();
+  const cl::Buffer tb = h.buffer(tris), out = h.buffer<float>(want.size());
+  h.run("curvatures", want.size(), tb, cl_uint(want.size()), out);
+  const std::vector<float> got = h.read<float>(out, want.size());
+  for (std::size_t i = 0; i < want.size(); ++i)
+    EXPECT_NEAR(got[i], want[i], 1e-5 * std::max(1.0, std::abs(want[i])) + 1e-6) << i;
 }
 
 }  // namespace

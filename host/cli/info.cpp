@@ -92,7 +92,7 @@ SceneInfo scene_info(const Scene& scene, const InfoOptions& options) {
   info.settings.height = options.height;
   info.state = state_memory(info.settings, info.features);
 
-  SceneCounts counts = scene_counts(scene, nullptr);
+  SceneCounts counts = scene_counts(scene, nullptr, info.features.texture_lod);
   counts.lights = lights.lights.size();
   std::vector<std::uint32_t> flags;
   const bvh::BuildInput input = bvh_input(scene, flags);

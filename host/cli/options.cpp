@@ -246,6 +246,12 @@ void add_scene_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& setti
                   "nearest (the texel, blocky when magnified); importance sampling stays exact")
       ->check(CLI::IsMember({"bilinear", "nearest"}))
       ->capture_default_str();
+  app->add_option("--mipmaps", cli.mipmaps,
+                  "Textures seen small: on (each path's ray cone picks a level of the texture's "
+                  "mip chain, trilinear: less noise, slightly blurred) or off (full resolution "
+                  "always; the pixel's samples average the texels)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   app->add_option("--env-intensity", settings.env_intensity, "Scale of the environment map")
       ->capture_default_str();
   app->add_option("--env-rotation", settings.env_rotation,
@@ -430,6 +436,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   wp::validate(settings);
   settings.env_filter =
       cli.env_filter == "nearest" ? wp::EnvFilter::kNearest : wp::EnvFilter::kBilinear;
+  settings.mipmaps = cli.mipmaps == "on";
   if (!cli.env.empty())
     settings.environment =
         std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env, settings.env_filter));

@@ -26,6 +26,7 @@ struct CliOptions {
   std::vector<float> env_color{0.0f, 0.0f, 0.0f};
   std::string env;
   std::string env_filter = "bilinear";
+  std::string mipmaps = "on";
   std::string strategy = "mis";
   std::string heuristic = "power";
   std::string light_select = "power";

@@ -10,6 +10,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "host/scene/mipmap.h"
 #include "host/util/error.h"
 
 namespace wp {
@@ -98,27 +99,68 @@ dev::uint wrap_bits(Wrap w) {
                                    : WP_WRAP_MIRROR;
 }
 
-dev::TextureRef device_texture(const TextureRef& t) {
+// The texture's term of its mip level (TextureRef.meta.w, kernels/ray_cone.h): 1/2 log2 of the
+// texels its coordinates' unit square covers, the image's width x height times the area scale of
+// the transform; -INFINITY (level 0 always) without a chain.
+float lod_term(const TextureRef& t, const dev::TextureImage& image) {
+  const double det = double(t.row_u.x) * t.row_v.y - double(t.row_u.y) * t.row_v.x;
+  if (!t.mipmaps || image.levels < 2 || !(std::fabs(det) > 0.0)) return -INFINITY;
+  return static_cast<float>(0.5 * std::log2(double(image.width) * image.height * std::fabs(det)));
+}
+
+dev::TextureRef device_texture(const TextureRef& t, const dev::TextureImage& image) {
   dev::TextureRef d{};
   d.transform_u = f4(t.row_u);
   d.transform_v = f4(t.row_v);
   dev::uint bits = wrap_bits(t.wrap_s) | (wrap_bits(t.wrap_t) << 8);
   if (t.nearest) bits |= WP_TEX_NEAREST;
   if (t.srgb) bits |= WP_TEX_SRGB;
-  d.meta = {static_cast<dev::uint>(t.image), bits, static_cast<dev::uint>(t.texcoord), 0u};
+  const float lod = lod_term(t, image);
+  dev::uint lod_bits;
+  std::memcpy(&lod_bits, &lod, sizeof lod_bits);
+  d.meta = {static_cast<dev::uint>(t.image), bits, static_cast<dev::uint>(t.texcoord), lod_bits};
   return d;
 }
 
-// All images' texels in one array, RGBA8 with R in the lowest byte.
-void pack_images(const Scene& scene, std::vector<dev::TextureImage>& images,
+void pack_rgba8(const std::vector<std::uint8_t>& rgba, std::vector<dev::uint>& texels) {
+  for (std::size_t i = 0; i + 3 < rgba.size(); i += 4)
+    texels.push_back(dev::uint(rgba[i]) | dev::uint(rgba[i + 1]) << 8 |
+                     dev::uint(rgba[i + 2]) << 16 | dev::uint(rgba[i + 3]) << 24);
+}
+
+// Per image: whether it gets a mip chain (with `mipmaps`, when a texture minifies it through
+// mip-maps, TextureRef::mipmaps), and whether a texture uses it as colour (sRGB).
+struct ImageUses {
+  std::vector<char> chained, colour;
+};
+ImageUses image_uses(const Scene& scene, bool mipmaps) {
+  ImageUses u{std::vector<char>(scene.images.size(), 0), std::vector<char>(scene.images.size(), 0)};
+  for (const TextureRef& t : scene.textures) {
+    if (t.image < 0 || std::size_t(t.image) >= scene.images.size()) continue;
+    u.chained[std::size_t(t.image)] |= mipmaps && t.mipmaps;
+    u.colour[std::size_t(t.image)] |= t.srgb;
+  }
+  return u;
+}
+
+// The levels image i is packed with.
+int packed_levels(const Image& img, const ImageUses& uses, std::size_t i) {
+  return uses.chained[i] ? mip_levels(img.width, img.height) : 1;
+}
+
+// All images' texels in one array, RGBA8 with R in the lowest byte; with `mipmaps`, each image
+// image_uses chains followed by its chain, filtered as colour when a texture uses it as colour
+// (sRGB), else as data.
+void pack_images(const Scene& scene, bool mipmaps, std::vector<dev::TextureImage>& images,
                  std::vector<dev::uint>& texels) {
-  for (const Image& img : scene.images) {
-    const std::size_t n = std::size_t(img.width) * std::size_t(img.height);
+  const ImageUses uses = image_uses(scene, mipmaps);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    const Image& img = scene.images[i];
+    const int levels = packed_levels(img, uses, i);
     images.push_back({static_cast<dev::uint>(texels.size()), static_cast<dev::uint>(img.width),
-                      static_cast<dev::uint>(img.height), 0u});
-    for (std::size_t i = 0; i < n; ++i)
-      texels.push_back(dev::uint(img.rgba[4 * i]) | dev::uint(img.rgba[4 * i + 1]) << 8 |
-                       dev::uint(img.rgba[4 * i + 2]) << 16 | dev::uint(img.rgba[4 * i + 3]) << 24);
+                      static_cast<dev::uint>(img.height), static_cast<dev::uint>(levels)});
+    pack_rgba8(img.rgba, texels);
+    if (levels > 1) pack_rgba8(mip_chain(img, uses.colour[i] != 0), texels);
   }
 }
 
@@ -191,11 +233,12 @@ struct DeviceMaterials {
   std::vector<dev::uint> texels;
 };
 
-DeviceMaterials device_materials(const Scene& scene) {
+DeviceMaterials device_materials(const Scene& scene, bool mipmaps) {
   DeviceMaterials m;
   for (const Material& material : scene.materials) m.materials.push_back(device_material(material));
-  for (const TextureRef& t : scene.textures) m.textures.push_back(device_texture(t));
-  pack_images(scene, m.images, m.texels);
+  pack_images(scene, mipmaps, m.images, m.texels);
+  for (const TextureRef& t : scene.textures)
+    m.textures.push_back(device_texture(t, m.images.at(static_cast<std::size_t>(t.image))));
   if (m.texels.size() > 0xffffffffu) throw Error(too_many_texels());
   return m;
 }
@@ -268,8 +311,13 @@ void describe_scene(const Scene& scene, const SceneExtras& x, dev::SceneDesc& d)
 
 PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
                        std::uint64_t max_buffer) {
-  const DeviceMaterials materials = device_materials(scene);
+  const DeviceMaterials materials = device_materials(scene, x.mipmaps);
   PackedScene p;
+  p.texel_bytes = materials.texels.size() * kTexelBytes;
+  std::uint64_t level0 = 0;
+  for (const dev::TextureImage& image : materials.images)
+    level0 += std::uint64_t(image.width) * image.height * kTexelBytes;
+  p.mip_bytes = p.texel_bytes - level0;
   const std::vector<SceneArray> arrays = scene_arrays(scene, bvh, x, materials, p.desc);
   std::vector<std::uint64_t> sizes;
   for (const SceneArray& a : arrays) sizes.push_back(a.bytes);
@@ -339,15 +387,20 @@ const char* scene_array_name(std::size_t index) {
   return kArrayNames.at(index);
 }
 
-SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env) {
+SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mipmaps) {
   SceneCounts c;
   c.triangles = scene.triangle_count();
   c.vertices = scene.positions.size();
   c.materials = scene.materials.size();
   c.textures = scene.textures.size();
   c.images = scene.images.size();
-  for (const Image& img : scene.images)
-    c.texels += std::uint64_t(std::max(img.width, 0)) * std::uint64_t(std::max(img.height, 0));
+  const ImageUses uses = image_uses(scene, mipmaps);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    const Image& img = scene.images[i];
+    for (int k = 0; k < packed_levels(img, uses, i); ++k)
+      c.texels += std::uint64_t(std::max(mip_size(img.width, k), 0)) *
+                  std::uint64_t(std::max(mip_size(img.height, k), 0));
+  }
   c.lights = scene.lights.size();
   if (env) {
     c.env_texels = env->texels.size();

@@ -45,6 +45,8 @@ struct PackedScene {
   std::vector<SceneBytes> buffers;  // 1 to WP_SCENE_BUFFERS, uploaded as they are
   dev::SceneDesc desc{};
   std::uint64_t buffer_map = 0;  // the program's WP_SCENE_BUFFER_MAP (SceneLayout::buffer_map)
+  // The texel array's bytes, and those of it that are mip levels (SceneExtras::mipmaps).
+  std::uint64_t texel_bytes = 0, mip_bytes = 0;
 };
 
 // The most bytes one scene buffer may hold: a uint of 64-byte units reaches 256 GiB.
@@ -64,6 +66,9 @@ struct SceneExtras {
   float env_intensity = 1.0f;
   float env_rotation_degrees = 0.0f;
   const LightTable* lights = nullptr;  // required
+  // Mip chains after the images that textures minify through mip-maps (host/scene/mipmap.h), for
+  // programs with WP_FEATURE_TEXTURE_LOD; without them every image has one level.
+  bool mipmaps = false;
 };
 
 // Packs the scene into buffers of at most `max_buffer` bytes (the device's CL_DEVICE_MAX_MEM_ALLOC
@@ -109,7 +114,8 @@ struct SceneCounts {
   std::uint64_t lights = 0;
   std::uint64_t env_texels = 0, env_marginal = 0, env_conditional = 0;  // no map: 0
 };
-SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env);  // env may be null
+// env may be null; `mipmaps` counts the mip chains pack_scene adds with SceneExtras::mipmaps.
+SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mipmaps = false);
 
 // The bytes of the BVH's two packed arrays (nodes, then triangles or blocks).
 struct BvhBytes {

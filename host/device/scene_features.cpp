@@ -41,6 +41,7 @@ SceneFeatures SceneFeatures::of(const Scene& scene, bool has_environment_map) {
            (!x.unlit && uses_extension_textures(x));
   });
   f.normal_maps = any(m, [](const Material& x) { return x.normal_texture >= 0; });
+  f.texture_lod = f.textures && any(scene.textures, [](const TextureRef& t) { return t.mipmaps; });
   f.alpha = any(m, [](const Material& x) { return x.alpha_mode != AlphaMode::kOpaque; });
   f.unlit = any(m, [](const Material& x) { return x.unlit; });
   f.transmission = any(
@@ -80,6 +81,7 @@ std::vector<std::pair<std::string, bool>> SceneFeatures::flags() const {
           {"WP_FEATURE_ENVIRONMENT", environment},
           {"WP_FEATURE_VERTEX_COLORS", vertex_colors},
           {"WP_FEATURE_TEXTURES", textures},
+          {"WP_FEATURE_TEXTURE_LOD", texture_lod},
           {"WP_FEATURE_NORMAL_MAPS", normal_maps},
           {"WP_FEATURE_ALPHA", alpha},
           {"WP_FEATURE_UNLIT", unlit},

@@ -17,6 +17,9 @@ struct SceneFeatures {
   bool environment = true;  // an environment map (not the constant background)
   bool vertex_colors = true;
   bool textures = true;
+  // A texture whose sampler allows mip-maps: textures are minified through ray cones
+  // (kernels/ray_cone.h; emission and alpha excepted); off with --mipmaps off.
+  bool texture_lod = true;
   bool normal_maps = true;
   bool alpha = true;
   bool unlit = true;

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "host/scene/srgb.h"
+
 namespace wp {
 
 namespace {
@@ -18,10 +20,6 @@ int wrap_texel(long long i, int n, Wrap mode) {
   }
   long long m = i % n;
   return static_cast<int>(m < 0 ? m + n : m);
-}
-
-double srgb_to_linear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
 }
 
 // A texture's image with its decoding, for lookups by texel index.

@@ -70,8 +70,8 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
                                        : "bsdf")
     << ";mis_heuristic=" << (s.mis_heuristic == MisHeuristic::kPower ? "power" : "balance")
     << ";light_select=" << (s.light_select == LightSelect::kPower ? "power" : "uniform")
-    << ";sampler=" << sampler_name(s.sampler) << ";camera=" << s.camera << ";view={"
-    << view_text(s.view) << "}"
+    << ";sampler=" << sampler_name(s.sampler) << ";mipmaps=" << (s.mipmaps ? "on" : "off")
+    << ";camera=" << s.camera << ";view={" << view_text(s.view) << "}"
     << ";features=" << (s.all_features ? "all" : "scene") << ";bvh_width=" << bvh_width
     << ";spatial_splits=" << (spatial_splits ? 1 : 0) << ";aov=" << (s.aov ? 1 : 0)
     << ";kernels=" << hex64(kernel_digest);
@@ -141,7 +141,9 @@ bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings&
                    const RenderOptions& options, const bvh::BuildOptions& bvh_options,
                    bool* cached) {
   std::vector<std::uint32_t> flags;
-  const SceneCounts counts = scene_counts(scene, settings.environment.get());
+  const SceneCounts counts =
+      scene_counts(scene, settings.environment.get(),
+                   render_features(scene, settings, settings.environment != nullptr).texture_lod);
   const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
   check_scene_memory(
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)
@@ -170,6 +172,8 @@ void report_setup(RenderReport& r, const ClRuntime& runtime, const Scene& scene,
   r.wave_size = wavefront.wave_paths();
   r.bytes_per_path = wavefront.path_state().bytes_per_path;
   r.scene_bytes = wavefront.scene_bytes();
+  r.texture_bytes = wavefront.texture_bytes();
+  r.mip_bytes = wavefront.mip_bytes();
   r.scene_buffers = wavefront.scene_buffer_count();
 }
 

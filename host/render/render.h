@@ -49,8 +49,10 @@ struct RenderReport {
   std::size_t wave_size = 0;
   std::size_t bytes_per_path = 0;
   std::uint64_t scene_bytes = 0;  // the packed scene on the device
-  int scene_buffers = 0;          // the buffers it is split over (device_scene.h)
-  StageTimes stages;              // with RenderSettings::profile
+  // Of it, the textures' texels, and of those the mip levels (at most a third of the rest).
+  std::uint64_t texture_bytes = 0, mip_bytes = 0;
+  int scene_buffers = 0;  // the buffers it is split over (device_scene.h)
+  StageTimes stages;      // with RenderSettings::profile
   // The film holds samples [settings.sample_begin, sample_end): all requested, or fewer when the
   // passes stopped early (`stop`).
   std::uint32_t sample_end = 0;

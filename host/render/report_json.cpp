@@ -43,6 +43,7 @@ std::map<std::string, std::string> exr_attributes(const std::string& scene, cons
           {"wavepath:env_intensity", num(s.env_intensity)},
           {"wavepath:env_rotation", num(s.env_rotation)},
           {"wavepath:env_filter", env_filter_name(s.env_filter)},
+          {"wavepath:mipmaps", s.mipmaps ? "on" : "off"},
           {"wavepath:device", r.device},
           {"wavepath:features", r.features},
           {"wavepath:nonfinite_samples", std::to_string(r.nonfinite_samples)},
@@ -82,6 +83,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"features\":" << json_string(r.features)
     << ",\"build_options\":" << json_string(r.build_options) << ",\"wave_size\":" << r.wave_size
     << ",\"bytes_per_path\":" << r.bytes_per_path << ",\"scene_bytes\":" << r.scene_bytes
+    << ",\"texture_bytes\":" << r.texture_bytes << ",\"mip_bytes\":" << r.mip_bytes
     << ",\"scene_buffers\":" << r.scene_buffers << ",\"ranks\":" << r.ranks << ",\"outputs\":[";
   for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);
   o << "]";

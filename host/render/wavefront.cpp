@@ -61,6 +61,14 @@ const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
 
 }  // namespace
 
+SceneFeatures render_features(const Scene& scene, const RenderSettings& settings,
+                              bool has_environment_map) {
+  SceneFeatures f =
+      settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, has_environment_map);
+  if (!settings.mipmaps) f.texture_lod = false;
+  return f;
+}
+
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.scene_buffer_bytes) return settings.scene_buffer_bytes;
   return device.max_alloc ? device.max_alloc : kSceneBufferReach;
@@ -103,8 +111,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     settings_.environment = std::move(rebuilt);
   }
   const EnvironmentMap* env = settings_.environment.get();
-  features_ =
-      settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
+  features_ = render_features(scene, settings, env != nullptr);
   // Cache hints in the stages that read path state through a queue (kernels/features.h,
   // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
   // instruction and every address space is one.
@@ -132,6 +139,7 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
   extras.env_intensity = settings_.env_intensity;
   extras.env_rotation_degrees = settings_.env_rotation;
   extras.lights = &lights_;
+  extras.mipmaps = features_.texture_lod;
   // On a CPU device the kernels read the packed scene in place, which therefore stays here; a GPU
   // gets its own copy, and the host's goes at the end of this function.
   const bool in_place = !rt_.device().gpu;
@@ -139,6 +147,8 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
   scene_ = upload_scene(rt_.context(), packed, in_place);
   scene_buffer_count_ = static_cast<int>(packed.buffers.size());
   for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
+  texture_bytes_ = packed.texel_bytes;
+  mip_bytes_ = packed.mip_bytes;
   // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
   // buffer leaves the options as they were.
   if (packed.buffer_map) {

@@ -61,6 +61,9 @@ struct RenderSettings {
   // The map's lookup (--env-filter); a map whose tables were built for the other filter gets
   // tables rebuilt for this one (Wavefront's constructor).
   EnvFilter env_filter = EnvFilter::kBilinear;
+  // Minify textures through mip chains at the level of each path's ray cone (--mipmaps;
+  // kernels/ray_cone.h), where the scene has a texture whose sampler allows mip-maps.
+  bool mipmaps = true;
   Strategy strategy = Strategy::kMis;
   MisHeuristic mis_heuristic = MisHeuristic::kPower;
   LightSelect light_select = LightSelect::kPower;
@@ -98,6 +101,12 @@ constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 
 // The most bytes of one scene buffer on `device` with `settings`.
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
+
+// The kernel features a render of `scene` with `settings` builds: the scene's (or all of them with
+// all_features), without texture_lod under --mipmaps off. texture_lod also decides whether the
+// packed scene carries mip chains (SceneExtras::mipmaps, scene_counts).
+SceneFeatures render_features(const Scene& scene, const RenderSettings& settings,
+                              bool has_environment_map);
 
 // The paths of one wave for `settings` (RenderSettings::wave_size): `pixels` pixels, `samples`
 // samples of each.
@@ -148,6 +157,8 @@ class Wavefront {
   std::uint64_t rays_traced() const { return rays_traced_; }
   // The packed scene on the device: its bytes and the buffers they are split over.
   std::uint64_t scene_bytes() const { return scene_bytes_; }
+  std::uint64_t texture_bytes() const { return texture_bytes_; }
+  std::uint64_t mip_bytes() const { return mip_bytes_; }
   int scene_buffer_count() const { return scene_buffer_count_; }
 
   // Stage-level access for tests and benchmarks. Field offsets are those of path_state().layout,
@@ -257,6 +268,7 @@ class Wavefront {
   std::vector<SceneBytes> packed_;
   SceneBuffers scene_;
   std::uint64_t scene_bytes_ = 0;
+  std::uint64_t texture_bytes_ = 0, mip_bytes_ = 0;
   int scene_buffer_count_ = 0;
   cl::Buffer path_buf_, queue_slots_, counters_, film_;
   cl::Program program_;

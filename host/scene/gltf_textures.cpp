@@ -13,7 +13,8 @@
 namespace wp::gltf {
 namespace {
 
-constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728;
+constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728,
+              kLinear = 9729;  // glTF sampler filters without mip-maps
 
 std::string image_name(const tinygltf::Model& model, int index) {
   const tinygltf::Image& image = model.images[static_cast<std::size_t>(index)];
@@ -60,8 +61,8 @@ const tinygltf::Value* transform_of(const tinygltf::ExtensionMap& extensions) {
 
 bool same_use(const TextureRef& a, const TextureRef& b) {
   return a.image == b.image && a.wrap_s == b.wrap_s && a.wrap_t == b.wrap_t &&
-         a.nearest == b.nearest && a.srgb == b.srgb && a.texcoord == b.texcoord &&
-         a.row_u == b.row_u && a.row_v == b.row_v;
+         a.nearest == b.nearest && a.mipmaps == b.mipmaps && a.srgb == b.srgb &&
+         a.texcoord == b.texcoord && a.row_u == b.row_u && a.row_v == b.row_v;
 }
 
 // A PNG's chunks, walked before stb_image sees the file: every chunk's length must fit in the
@@ -197,6 +198,7 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
     ref.wrap_s = wrap_mode(s.wrapS, sampler_where, "wrapS");
     ref.wrap_t = wrap_mode(s.wrapT, sampler_where, "wrapT");
     ref.nearest = s.magFilter == kNearest;
+    ref.mipmaps = s.minFilter != kNearest && s.minFilter != kLinear;
   }
   ref.srgb = srgb;
   ref.texcoord = texcoord;

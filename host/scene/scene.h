@@ -43,6 +43,9 @@ struct TextureRef {
   int texcoord = 0;      // TEXCOORD_0 or TEXCOORD_1
   // KHR_texture_transform as a 2x3 matrix: (u', v') = (row_u . (u, v, 1), row_v . (u, v, 1)).
   glm::vec3 row_u{1.0f, 0.0f, 0.0f}, row_v{0.0f, 1.0f, 0.0f};
+  // minFilter a mip-map mode or unset: minified through its mip chain (host/scene/mipmap.h);
+  // minFilter NEAREST or LINEAR ask for none, and get full resolution always.
+  bool mipmaps = true;
 };
 
 struct Material {

@@ -6,6 +6,7 @@
 
 #include "stage.h"
 #include "camera.h"
+#include "ray_cone.h"
 
 /* Starts the path in `slot` of the wave (slot < launch.path_count). */
 WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, uint slot) {
@@ -24,8 +25,15 @@ WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, ui
   /* A camera ray: no BSDF sample to weigh against (pdf 0). */
   path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
   path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
+#if WP_FEATURE_TEXTURE_LOD
+  /* Flags and bounce 0, and the camera's ray cone (ray_cone.h). */
+  const float2 cone = camera_cone(camera, launch.height);
+  path_set_bounce_word(paths, slot, with_high_bf16(0u, cone.x));
+  path_set_flags_word(paths, slot, with_high_bf16(0u, cone.y));
+#else
   path_set_flags(paths, slot, 0u);
   path_set_bounce(paths, slot, 0u);
+#endif
 #if WP_AOV
   path_store_aov_albedo(paths, slot, (float3)(0.0f), 0.0f);
   path_store_aov_normal(paths, slot, (float3)(0.0f), 0.0f);

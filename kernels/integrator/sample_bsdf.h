@@ -8,6 +8,7 @@
 #define WP_INTEGRATOR_SAMPLE_BSDF_H
 
 #include "stage.h"
+#include "ray_cone.h"
 #include "surface.h"
 
 /* The next ray of the path in `slot` from surface s, hit at distance t, with the bounce's random
@@ -37,10 +38,16 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
 #endif
   {
 #if WP_FEATURE_DISPERSION
-    path_set_flags(paths, slot,
-                   (bs.delta ? WP_PATH_DELTA : 0u) | (bs.channel << WP_PATH_CHANNEL_SHIFT));
+    const uint flags = (bs.delta ? WP_PATH_DELTA : 0u) | (bs.channel << WP_PATH_CHANNEL_SHIFT);
 #else
-    path_set_flags(paths, slot, bs.delta ? WP_PATH_DELTA : 0u);
+    const uint flags = bs.delta ? WP_PATH_DELTA : 0u;
+#endif
+#if WP_FEATURE_TEXTURE_LOD
+    /* The flags, and the ray cone widened by the lobe the sample came from (ray_cone.h). */
+    path_set_flags_word(paths, slot,
+                        with_high_bf16(flags, path_cone(paths, slot).y + lobe_spread(bs.pdf)));
+#else
+    path_set_flags(paths, slot, flags);
 #endif
   }
   path_store_throughput(paths, slot, next, pdf);

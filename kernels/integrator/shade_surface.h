@@ -55,7 +55,19 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   const uint tri = path_hit_triangle(paths, slot);
   const uint4 tv = scene->tri_vertices[tri];
   bool front;
-  *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, &front);
+#if WP_FEATURE_TEXTURE_LOD
+  /* The ray cone across the hit, and bent by the surface's curvature for the ray that leaves it
+   * (ray_cone.h; sample_next_ray adds the lobe's spread). */
+  const float2 cone = path_cone(paths, slot);
+  const float width = cone_width_at(cone, t);
+  *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, width,
+                       &front);
+  path_set_cone_width(paths, slot, width);
+  path_set_cone_spread(paths, slot, cone_spread_curved(cone.y, s->curvature, width));
+#else
+  *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, 0.0f,
+                       &front);
+#endif
 #if WP_FEATURE_DISPERSION
   s->channel = (path_flags(paths, slot) & WP_PATH_CHANNEL_MASK) >> WP_PATH_CHANNEL_SHIFT;
 #endif

@@ -48,7 +48,7 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
     }
     const uint4 tv = scene->tri_vertices[hit.tri];
     bool front;
-    const Surface s = resolve_surface(scene, tv, hit.u, hit.v, d, &front);
+    const Surface s = resolve_surface(scene, tv, hit.u, hit.v, d, 0.0f, &front);
     if (layer == WP_SHADOW_MAX_LAYERS || !bsdf_has_delta(&s) || !bsdf_transmits(&s) ||
         bsdf_volume(&s))
       return; /* an occluder */

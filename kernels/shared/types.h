@@ -91,14 +91,17 @@ typedef struct TextureRef {
   float4 transform_u; /* u' = x u + y v + z */
   float4 transform_v; /* v' = x u + y v + z */
   uint4 meta; /* x: TextureImage index; y: wrap S (bits 0-7) | wrap T (bits 8-15) | WP_TEX_* flags;
-                 z: texture coordinate set (0 or 1); w: unused */
+                 z: texture coordinate set (0 or 1); w: the bits of a float, the texture's term
+                 of its mip level, 1/2 log2(width x height x |det| of the transform's 2 x 2 part)
+                 (kernels/ray_cone.h), or -INFINITY: no mip-maps (level 0 always) */
 } TextureRef;
 
 /* A decoded image: width x height texels, row by row from the top (glTF's uv (0,0) is the
  * top-left corner), each a uint of RGBA8 with R in the lowest byte, starting at `offset` in the
- * texel array. */
+ * texel array; then its mip levels 1 .. levels - 1, each right after the one before, each half
+ * the size of the one before, rounding down (host/device/mipmap.h; levels = 1: none). */
 typedef struct TextureImage {
-  uint offset, width, height, pad;
+  uint offset, width, height, levels;
 } TextureImage;
 
 /* Everything next-event estimation can choose. */

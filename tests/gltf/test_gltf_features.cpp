@@ -31,24 +31,16 @@ wp::SceneFeatures features_of(const std::string& material) {
 TEST(GltfFeatures, PlainSceneKeepsItsFlags) {
   const wp::SceneFeatures f = features_of("{}");
   const std::vector<std::pair<std::string, bool>> expected = {
-      {"WP_FEATURE_PUNCTUAL_LIGHTS", false},
-      {"WP_FEATURE_SPOT_LIGHTS", false},
-      {"WP_FEATURE_EMISSION", false},
-      {"WP_FEATURE_ENVIRONMENT", false},
-      {"WP_FEATURE_VERTEX_COLORS", false},
-      {"WP_FEATURE_TEXTURES", false},
-      {"WP_FEATURE_NORMAL_MAPS", false},
-      {"WP_FEATURE_ALPHA", false},
-      {"WP_FEATURE_UNLIT", false},
+      {"WP_FEATURE_PUNCTUAL_LIGHTS", false}, {"WP_FEATURE_SPOT_LIGHTS", false},
+      {"WP_FEATURE_EMISSION", false},        {"WP_FEATURE_ENVIRONMENT", false},
+      {"WP_FEATURE_VERTEX_COLORS", false},   {"WP_FEATURE_TEXTURES", false},
+      {"WP_FEATURE_TEXTURE_LOD", false},     {"WP_FEATURE_NORMAL_MAPS", false},
+      {"WP_FEATURE_ALPHA", false},           {"WP_FEATURE_UNLIT", false},
       {"WP_FEATURE_GLOSSY", true},  // glTF's default material is metallic
-      {"WP_FEATURE_TRANSMISSION", false},
-      {"WP_FEATURE_VOLUME", false},
-      {"WP_FEATURE_SPECULAR", false},
-      {"WP_FEATURE_CLEARCOAT", false},
-      {"WP_FEATURE_SHEEN", false},
-      {"WP_FEATURE_ANISOTROPY", false},
-      {"WP_FEATURE_IRIDESCENCE", false},
-      {"WP_FEATURE_DIFFUSE_TRANSMISSION", false},
+      {"WP_FEATURE_TRANSMISSION", false},    {"WP_FEATURE_VOLUME", false},
+      {"WP_FEATURE_SPECULAR", false},        {"WP_FEATURE_CLEARCOAT", false},
+      {"WP_FEATURE_SHEEN", false},           {"WP_FEATURE_ANISOTROPY", false},
+      {"WP_FEATURE_IRIDESCENCE", false},     {"WP_FEATURE_DIFFUSE_TRANSMISSION", false},
       {"WP_FEATURE_DISPERSION", false}};
   EXPECT_EQ(f.flags(), expected);
   EXPECT_EQ(f.describe(), "glossy");
@@ -71,20 +63,21 @@ TEST(GltfFeatures, EachExtensionTurnsOnItsFeature) {
   EXPECT_EQ(features_of(material("")).describe(), "none");
   for (const auto& [extensions, expected] : std::vector<std::pair<std::string, std::string>>{
            {R"("KHR_materials_clearcoat":{"clearcoatFactor":0.5})", "glossy clearcoat"},
-           {R"("KHR_materials_clearcoat":{"clearcoatTexture":{"index":0}})", "textures"},
+           {R"("KHR_materials_clearcoat":{"clearcoatTexture":{"index":0}})",
+            "textures texture_lod"},
            {R"("KHR_materials_clearcoat":{"clearcoatFactor":1,)"
             R"("clearcoatNormalTexture":{"index":0}})",
-            "textures glossy clearcoat"},
+            "textures texture_lod glossy clearcoat"},
            {R"("KHR_materials_sheen":{"sheenColorFactor":[0,0,0.5]})", "glossy sheen"},
            {R"("KHR_materials_sheen":{"sheenRoughnessFactor":0.5})", "none"},
            {R"("KHR_materials_sheen":{"sheenColorFactor":[1,1,1],)"
             R"("sheenColorTexture":{"index":0}})",
-            "textures glossy sheen"},
+            "textures texture_lod glossy sheen"},
            {R"("KHR_materials_anisotropy":{"anisotropyStrength":0.5})", "glossy anisotropy"},
            {R"("KHR_materials_anisotropy":{"anisotropyRotation":1})", "none"},
            {R"("KHR_materials_iridescence":{"iridescenceFactor":1})", "glossy iridescence"},
            {R"("KHR_materials_iridescence":{"iridescenceThicknessTexture":{"index":0}})",
-            "textures"},
+            "textures texture_lod"},
            {R"("KHR_materials_diffuse_transmission":{"diffuseTransmissionFactor":0.5})",
             "glossy diffuse_transmission"},
            {R"("KHR_materials_diffuse_transmission":{"diffuseTransmissionColorFactor":[1,0,0]})",
@@ -108,9 +101,10 @@ TEST(GltfFeatures, EachExtensionTurnsOnItsFeature) {
            {R"({"specularFactor":0.5})", "glossy"},
            {R"({"specularFactor":0,"specularColorFactor":[1,0.5,1]})", "glossy specular"},
            {R"({"specularFactor":0,"specularColorFactor":[1,1,1]})", "none"},
-           {R"({"specularFactor":0,"specularTexture":{"index":0}})", "textures glossy specular"},
+           {R"({"specularFactor":0,"specularTexture":{"index":0}})",
+            "textures texture_lod glossy specular"},
            {R"({"specularFactor":0,"specularColorTexture":{"index":0}})",
-            "textures glossy specular"},
+            "textures texture_lod glossy specular"},
        }) {
     EXPECT_EQ(
         features_of("{" + lambert + R"(,"extensions":{"KHR_materials_specular":)" + specular + "}}")
