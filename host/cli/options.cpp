@@ -32,15 +32,10 @@ void check_outputs(const std::vector<std::string>& outputs) {
     const std::string ext = extension_of(o);
     if (ext != ".exr" && ext != ".png" && ext != ".pfm" && ext != ".wpfilm")
       throw wp::Error(o + ": unsupported output format (use .exr, .png, .pfm or .wpfilm)");
-    const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
-    if (!std::filesystem::is_directory(dir))
-      throw wp::Error(o + ": folder " + dir.string() + " does not exist");
-    if (access(dir.c_str(), W_OK | X_OK) != 0)
-      throw wp::Error(o + ": folder " + dir.string() + " is not writable (" + std::strerror(errno) +
-                      ")");
     std::error_code ec;
     const auto status = std::filesystem::symlink_status(p, ec);
     if (std::filesystem::is_directory(status)) throw wp::Error(o + ": is a directory");
+    wp::check_output_folder(o);  // by creating a file there: access(2) says yes to root
     if (std::filesystem::exists(status) && access(p.c_str(), W_OK) != 0)
       throw wp::Error(o + ": the existing file is not writable (" + std::strerror(errno) + ")");
   }

@@ -4,14 +4,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <system_error>
 #include <utility>
 
 #include <ImfChannelList.h>
@@ -20,6 +16,7 @@
 #include <ImfInputFile.h>
 
 #include "host/util/error.h"
+#include "host/util/files.h"
 
 namespace wp {
 
@@ -178,12 +175,7 @@ class RgbeReader {
 };
 
 void read_hdr(const std::string& path, EnvironmentMap& env) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                   std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(path + ": read failed: " + std::strerror(errno));
-  RgbeReader(path, std::move(bytes)).read(env);
+  RgbeReader(path, read_regular_file(path)).read(env);
 }
 
 // A data window of w x h pixels, checked before anything is allocated for it: a 417-byte file can
@@ -243,9 +235,7 @@ std::size_t exr_fixed_size(const std::string& type) {
 // file's headers with an empty header. A dataWindow is checked here too (check_exr_window): for a
 // window millions of pixels wide OpenEXR allocates line buffers before read_exr could look.
 void check_exr_attributes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)),
-                               std::istreambuf_iterator<char>());
+  const std::vector<unsigned char> b = read_regular_file(path);
   const auto fail = [&](const std::string& what) {
     return Error(path + ": the EXR header is corrupt (" + what + ")");
   };
@@ -399,8 +389,7 @@ EnvironmentMap load_environment(const std::string& path, EnvFilter filter) {
   const std::string ext = lower_extension(path);
   if (ext != ".hdr" && ext != ".exr")
     throw Error(path + ": unsupported environment map format (use .hdr or .exr)");
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": no such file");
+  require_regular_file(path);  // a FIFO must not block OpenEXR's open
   if (ext == ".hdr")
     read_hdr(path, env);
   else

@@ -1,0 +1,151 @@
+// Input at the edges, through the command line as users meet it: files that are not regular files
+// (a FIFO with no writer, a folder, a device) named as a scene, buffer, image, environment map or
+// film; outputs that cannot be written; an image the device cannot hold; values glTF allows but
+// float32 cannot carry. Each is one line `wavepath: error: ...` and status 1 (or a render without
+// a NaN), never a hang: every run has `timeout` before it, so that a hang fails (status 124)
+// instead of blocking the suite.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "host/film/image_io.h"
+#include "tests/cli_run.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using wp::test::CliRun;
+
+constexpr const char* kTimeout = "timeout 60";
+
+// One triangle (0,0,-1), (1,0,-1), (0,1,-1) facing +Z, seen by a camera at the origin; its buffer
+// and image are the files named `bin` and `png` (empty: none).
+std::string triangle_gltf(const std::string& bin, const std::string& png,
+                          const std::string& material = "{}") {
+  std::string s = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],)"
+                  R"("nodes":[{"mesh":0},{"camera":0,"translation":[0.3,0.3,0]}],)"
+                  R"("cameras":[{"type":"perspective","perspective":{"yfov":0.5,"znear":0.01}}],)"
+                  R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],)"
+                  R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",)"
+                  R"("min":[0,0,-1],"max":[1,1,-1]}],)"
+                  R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                  R"("buffers":[{"byteLength":36,"uri":")" +
+                  bin + R"("}],"materials":[)" + material + "]";
+  if (!png.empty()) s += R"(,"textures":[{"source":0}],"images":[{"uri":")" + png + R"("}])";
+  return s + "}";
+}
+
+void write_triangle_bin(const fs::path& path) {
+  const float p[9] = {0, 0, -1, 1, 0, -1, 0, 1, -1};
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(p), sizeof p);
+}
+
+class EdgeCli : public wp::test::FolderTest {
+ protected:
+  CliRun run(const std::string& args, const std::string& env = kTimeout) {
+    return wp::test::run_wavepath(dir_, args, env);
+  }
+
+  // Status 1 and exactly one line on stderr, `wavepath: error: ` and then text containing `cause`.
+  static void expect_error(const CliRun& r, const std::string& cause, const std::string& what) {
+    EXPECT_EQ(r.status, 1) << what << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("wavepath: error: ", 0), 0u) << what << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << what << ": more than one line: " << r.err;
+    EXPECT_NE(r.err.find(cause), std::string::npos) << what << ": " << r.err;
+  }
+
+  // Makes `name` in the folder a file of `kind`: a FIFO (no writer ever comes), a folder, or a
+  // symbolic link to the character device /dev/zero (which never ends).
+  void make_special(const std::string& name, const std::string& kind) {
+    const fs::path p = dir_ / name;
+    if (kind == "FIFO")
+      ASSERT_EQ(::mkfifo(p.c_str(), 0644), 0);
+    else if (kind == "directory")
+      fs::create_directories(p);
+    else
+      fs::create_symlink("/dev/zero", p);
+  }
+
+  // The folder's entries other than those named in `keep`.
+  std::vector<std::string> left_behind(const std::vector<std::string>& keep) const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      const std::string name = e.path().filename().string();
+      if (std::find(keep.begin(), keep.end(), name) == keep.end()) out.push_back(name);
+    }
+    return out;
+  }
+};
+
+const std::vector<std::pair<std::string, std::string>> kSpecialKinds = {
+    {"FIFO", "a FIFO"}, {"directory", "a directory"}, {"device", "a character device"}};
+
+// A scene, its buffer or image, an environment map or a film that is a FIFO, a folder or a device
+// is refused at once, naming the file and what it is. (Before: a FIFO blocked open() forever and
+// --env on one said "no such file".)
+TEST_F(EdgeCli, NonRegularInputFilesAreRefusedAtOnce) {
+  write_triangle_bin(dir_ / "tri.bin");
+  std::ofstream(dir_ / "good.gltf") << triangle_gltf("tri.bin", "");
+  ASSERT_EQ(run("info good.gltf").status, 0);  // the scene itself loads
+  for (const auto& [kind, says] : kSpecialKinds) {
+    const std::string cause = ": not a regular file (" + says + ")";
+    const std::string s = "s_" + kind;
+    make_special(s + ".gltf", kind);
+    expect_error(run("info " + s + ".gltf"), s + ".gltf" + cause, kind + " scene");
+    expect_error(run("render " + s + ".gltf -o out.exr"), s + ".gltf" + cause, kind + " scene");
+    make_special(s + ".bin", kind);
+    std::ofstream(dir_ / (s + "_buffer.gltf")) << triangle_gltf(s + ".bin", "");
+    expect_error(run("info " + s + "_buffer.gltf"), s + ".bin" + cause, kind + " buffer");
+    make_special(s + ".png", kind);
+    std::ofstream(dir_ / (s + "_image.gltf")) << triangle_gltf("tri.bin", s + ".png");
+    expect_error(run("info " + s + "_image.gltf"), s + ".png" + cause, kind + " image");
+    for (const char* ext : {".hdr", ".exr"}) {
+      make_special(s + ext, kind);
+      expect_error(run("render good.gltf -o out.exr --env " + s + ext), s + ext + cause,
+                   kind + " environment map");
+    }
+    make_special(s + ".wpfilm", kind);
+    expect_error(run("merge " + s + ".wpfilm -o out.exr"), s + ".wpfilm" + cause, kind + " film");
+    expect_error(run("render good.gltf -o out.exr --resume " + s + ".wpfilm"),
+                 s + ".wpfilm" + cause, kind + " film to resume");
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
+}
+
+// An output that cannot be created is refused before rendering, whatever the reason, and as root
+// too (where access(2) says yes): a folder that does not exist, a pseudo file system (/proc), a
+// path that is a folder. Nothing is left behind and an output the user had is not overwritten.
+TEST_F(EdgeCli, UnwritableOutputsAreRefusedBeforeRendering) {
+  write_triangle_bin(dir_ / "tri.bin");
+  std::ofstream(dir_ / "good.gltf") << triangle_gltf("tri.bin", "");
+  std::ofstream(dir_ / "keep.exr") << "old";
+  fs::create_directories(dir_ / "folder.exr");
+  const std::string render = "render good.gltf --width 8 --height 8 --spp 1 --json -o keep.exr ";
+  const std::string proc = "/proc/wavepath_edges_" + std::to_string(::getpid()) + ".exr";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"-o nowhere/out.png", "nowhere/out.png: folder nowhere does not exist"},
+      {"-o " + proc, proc + ": folder /proc is not writable"},
+      {"-o folder.exr", "folder.exr: is a directory"},
+      {"--checkpoint " + proc.substr(0, proc.size() - 4) + ".wpfilm",
+       "folder /proc is not writable"}};
+  for (const auto& [args, cause] : cases) {
+    const CliRun r = run(render + args);
+    expect_error(r, cause, args);
+    EXPECT_EQ(r.out, "") << args;  // no JSON report: nothing was rendered
+    EXPECT_EQ(wp::test::slurp(dir_ / "keep.exr"), "old") << args;
+    EXPECT_EQ(left_behind({"good.gltf", "tri.bin", "keep.exr", "folder.exr"}),
+              std::vector<std::string>{})
+        << args;
+  }
+  EXPECT_FALSE(fs::exists(proc));
+}
+
+}  // namespace
