@@ -89,7 +89,8 @@ void read_volume(const tinygltf::Material& in, const std::string& where, Materia
       throw Error(where + ": attenuationColor needs 3 numbers");
     for (int i = 0; i < 3; ++i) {
       if (!c.Get(i).IsNumber()) throw Error(where + ": attenuationColor is not numbers");
-      out.attenuation_color[i] = finite(c.Get(i).GetNumberAsDouble(), where, "attenuationColor");
+      out.attenuation_color[i] =
+          in_range(c.Get(i).GetNumberAsDouble(), 0.0, 1.0, where, "attenuationColor");
     }
   }
 }
@@ -121,7 +122,9 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
   out.double_sided = in.doubleSided;
   out.alpha_mode = alpha_mode(in.alphaMode, where);
   out.alpha_cutoff = finite(in.alphaCutoff, where, "alphaCutoff");
+  require(in.alphaCutoff >= 0.0, where, "alphaCutoff", ">= 0", in.alphaCutoff);
   out.ior = extension_number(in, "KHR_materials_ior", "ior", 1.5f, where);
+  require(out.ior == 0.0f || out.ior >= 1.0f, where, "ior", "0 or >= 1", out.ior);
   out.transmission = in_range(
       extension_number(in, "KHR_materials_transmission", "transmissionFactor", 0.0f, where), 0.0,
       1.0, where, "transmissionFactor");

@@ -72,21 +72,35 @@ Camera make_camera(const tinygltf::Model& model, int index, const glm::dmat4& wo
   const std::string where = "camera " + std::to_string(index) + " '" + in.name + "'";
   Camera out;
   out.name = in.name;
+  // glTF's schema: yfov, znear, aspectRatio and zfar > 0 and zfar > znear for a perspective
+  // camera; xmag and ymag not 0, znear >= 0, zfar > 0 and > znear for an orthographic one.
+  // tinygltf gives 0 for an absent aspectRatio or (perspective) zfar: only those present are read.
   if (in.type == "perspective") {
+    const tinygltf::PerspectiveCamera& p = in.perspective;
     out.type = CameraType::kPerspective;
-    out.yfov = finite(in.perspective.yfov, where, "yfov");
-    out.znear = finite(in.perspective.znear, where, "znear");
-    if (!(out.yfov > 0.0f && out.yfov < 3.14159f)) throw Error(where + ": yfov out of (0, pi)");
+    out.yfov = finite(p.yfov, where, "yfov");
+    out.znear = finite(p.znear, where, "znear");
+    require(p.yfov > 0.0, where, "yfov", "> 0", p.yfov);
+    require(out.yfov < 3.14159f, where, "yfov", "< pi", p.yfov);  // a pinhole sees less than 180
+    require(p.znear > 0.0, where, "znear", "> 0", p.znear);
+    require(finite(p.aspectRatio, where, "aspectRatio") >= 0.0f, where, "aspectRatio", "> 0",
+            p.aspectRatio);
+    if (finite(p.zfar, where, "zfar") != 0.0f)
+      require(p.zfar > p.znear, where, "zfar", "> znear", p.zfar);
   } else if (in.type == "orthographic") {
+    const tinygltf::OrthographicCamera& o = in.orthographic;
     out.type = CameraType::kOrthographic;
-    out.xmag = finite(in.orthographic.xmag, where, "xmag");
-    out.ymag = finite(in.orthographic.ymag, where, "ymag");
-    out.znear = finite(in.orthographic.znear, where, "znear");
-    if (out.xmag == 0.0f || out.ymag == 0.0f) throw Error(where + ": zero xmag or ymag");
+    out.xmag = finite(o.xmag, where, "xmag");
+    out.ymag = finite(o.ymag, where, "ymag");
+    out.znear = finite(o.znear, where, "znear");
+    require(o.xmag != 0.0, where, "xmag", "non-zero", o.xmag);
+    require(o.ymag != 0.0, where, "ymag", "non-zero", o.ymag);
+    require(o.znear >= 0.0, where, "znear", ">= 0", o.znear);
+    require(finite(o.zfar, where, "zfar") > 0.0f, where, "zfar", "> 0", o.zfar);
+    require(o.zfar > o.znear, where, "zfar", "> znear", o.zfar);
   } else {
     throw Error(where + ": unknown type '" + in.type + "'");
   }
-  if (out.znear < 0.0f) throw Error(where + ": negative znear");
   out.position = glm::vec3(world[3]);
   orientation(world, &out.forward, &out.up);
   return out;
@@ -122,7 +136,8 @@ PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dma
     for (int i = 0; i < 3; ++i)
       color[i] = in_range(in.color[static_cast<std::size_t>(i)], 0.0, 1.0, where, "color");
   out.intensity = color * in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
-  out.range = finite(in.range, where, "range");
+  out.range = finite(in.range, where, "range");  // tinygltf: 0 when absent (no range)
+  require(in.range >= 0.0, where, "range", "> 0", in.range);
   // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out; the
   // extension asks 0 <= inner < outer <= pi/2.
   out.inner_cone = in_range(in.spot.innerConeAngle, 0.0, M_PI / 2, where, "innerConeAngle");

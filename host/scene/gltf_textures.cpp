@@ -13,7 +13,8 @@
 namespace wp::gltf {
 namespace {
 
-constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728;
+constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728,
+              kLinear = 9729;
 
 std::string image_name(const tinygltf::Model& model, int index) {
   const tinygltf::Image& image = model.images[static_cast<std::size_t>(index)];
@@ -196,6 +197,8 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
     const std::string sampler_where = "sampler " + std::to_string(texture.sampler);
     ref.wrap_s = wrap_mode(s.wrapS, sampler_where, "wrapS");
     ref.wrap_t = wrap_mode(s.wrapT, sampler_where, "wrapT");
+    if (s.magFilter != -1 && s.magFilter != kNearest && s.magFilter != kLinear)
+      throw Error(sampler_where + ": unknown magFilter " + std::to_string(s.magFilter));
     ref.nearest = s.magFilter == kNearest;
   }
   ref.srgb = srgb;

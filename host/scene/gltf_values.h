@@ -31,4 +31,12 @@ inline float in_range(double value, double lo, double hi, const std::string& whe
   return v;
 }
 
+// Throws "WHERE: FIELD must be RULE (got VALUE)" unless `ok`: a rule of glTF's schema (or of an
+// extension's) that a finite number breaks, e.g. a camera's znear must be > 0.
+inline void require(bool ok, const std::string& where, const char* field, const char* rule,
+                    double value) {
+  if (!ok)
+    throw Error(where + ": " + field + " must be " + rule + " (got " + number_text(value) + ")");
+}
+
 }  // namespace wp::gltf
