@@ -148,4 +148,19 @@ TEST_F(EdgeCli, UnwritableOutputsAreRefusedBeforeRendering) {
   EXPECT_FALSE(fs::exists(proc));
 }
 
+// An image whose film the device cannot allocate is refused before any allocation, with the bytes
+// it needs and the device's limit, not with OpenCL's CL_INVALID_BUFFER_SIZE. (PoCL's largest
+// buffer is far below the 24 GiB of a 16384 x 16384 film; so is any GPU's today.)
+TEST_F(EdgeCli, ImageTheDeviceCannotHoldIsRefusedWithBothSizes) {
+  write_triangle_bin(dir_ / "tri.bin");
+  std::ofstream(dir_ / "good.gltf") << triangle_gltf("tri.bin", "");
+  const CliRun r = run("render good.gltf --width 16384 --height 16384 --spp 1 -o out.exr");
+  expect_error(r,
+               "image too large for the device: 16384 x 16384 needs a film buffer of 25769803776 "
+               "bytes (24.00 GiB), more than the ",
+               "16384 x 16384");
+  EXPECT_NE(r.err.find("(CL_DEVICE_MAX_MEM_ALLOC_SIZE)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
+}
+
 }  // namespace

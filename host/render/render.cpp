@@ -126,6 +126,26 @@ void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uin
                 gb(available) + " are available");
 }
 
+void check_state_memory(const StateMemory& memory, const RenderSettings& settings,
+                        const DeviceEntry& device) {
+  const std::string image =
+      std::to_string(settings.width) + " x " + std::to_string(settings.height);
+  const auto bytes = [](std::uint64_t b) {
+    return std::to_string(b) + " bytes (" + human_bytes(b) + ")";
+  };
+  const std::pair<const char*, std::uint64_t> buffers[] = {
+      {"film", memory.film}, {"path state", memory.path_state.bytes}, {"queue", memory.queues}};
+  for (const auto& [name, size] : buffers)
+    if (device.max_alloc && size > device.max_alloc)
+      throw Error("image too large for the device: " + image + " needs a " + name + " buffer of " +
+                  bytes(size) + ", more than the " + bytes(device.max_alloc) + " " + device.name +
+                  " allocates at once (CL_DEVICE_MAX_MEM_ALLOC_SIZE)");
+  if (device.global_memory && memory.total() > device.global_memory)
+    throw Error("image too large for the device: " + image + " needs " + bytes(memory.total()) +
+                " of path state, queues and film, more than the " + bytes(device.global_memory) +
+                " of " + device.name + " (CL_DEVICE_GLOBAL_MEM_SIZE)");
+}
+
 int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.bvh_width) return settings.bvh_width;
   return device.gpu ? 2 : 8;
@@ -306,6 +326,8 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   const auto start = std::chrono::steady_clock::now();
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
+  check_state_memory(state_memory(settings, render_features(scene, settings)), settings,
+                     runtime.device());
   bool cached = false;
   const bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
   Wavefront wavefront(runtime, scene, bvh, settings);

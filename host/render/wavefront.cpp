@@ -86,6 +86,11 @@ StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& fe
   return m;
 }
 
+SceneFeatures render_features(const Scene& scene, const RenderSettings& settings) {
+  return settings.all_features ? SceneFeatures::all()
+                               : SceneFeatures::of(scene, settings.environment != nullptr);
+}
+
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
     : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
@@ -103,8 +108,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     settings_.environment = std::move(rebuilt);
   }
   const EnvironmentMap* env = settings_.environment.get();
-  features_ =
-      settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, env != nullptr);
+  features_ = render_features(scene, settings);
   // Cache hints in the stages that read path state through a queue (kernels/features.h,
   // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
   // instruction and every address space is one.

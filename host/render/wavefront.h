@@ -119,6 +119,10 @@ struct StateMemory {
 };
 StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features);
 
+// The kernel features a render of `scene` compiles in: all of them with settings.all_features,
+// else those the scene (and settings.environment) uses.
+SceneFeatures render_features(const Scene& scene, const RenderSettings& settings);
+
 // Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
 struct StageTimes {
   std::array<double, kStageCount> seconds{};
