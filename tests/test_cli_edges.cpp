@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -161,6 +162,115 @@ TEST_F(EdgeCli, ImageTheDeviceCannotHoldIsRefusedWithBothSizes) {
                "16384 x 16384");
   EXPECT_NE(r.err.find("(CL_DEVICE_MAX_MEM_ALLOC_SIZE)"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
+}
+
+// Quads, one primitive each: (corner, edge u, edge v, material). Written as `name`.gltf with its
+// buffer `name`.bin beside it, a camera at (0, 0.8, 3.5) looking down -Z and a point light.
+struct Quad {
+  float p[3], u[3], v[3];
+  int material;
+};
+
+std::string quads_gltf(const fs::path& dir, const std::string& name, const std::vector<Quad>& quads,
+                       const std::string& materials, const std::string& light) {
+  std::vector<float> data;
+  std::string views, accessors, primitives;
+  for (std::size_t q = 0; q < quads.size(); ++q) {
+    const Quad& k = quads[q];
+    const float w[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    const std::size_t offset = data.size() * 4;
+    for (const int c : {0, 1, 2, 0, 2, 3})
+      for (int i = 0; i < 3; ++i) {
+        const float x = k.p[i] + w[c][0] * k.u[i] + w[c][1] * k.v[i];
+        data.push_back(x);
+        lo[i] = std::min(lo[i], x);
+        hi[i] = std::max(hi[i], x);
+      }
+    const std::string n = std::to_string(q), sep = q ? "," : "";
+    views += sep + R"({"buffer":0,"byteOffset":)" + std::to_string(offset) + R"(,"byteLength":72})";
+    accessors += sep + R"({"bufferView":)" + n +
+                 R"(,"componentType":5126,"count":6,"type":"VEC3",)" + R"("min":[)" +
+                 std::to_string(lo[0]) + "," + std::to_string(lo[1]) + "," + std::to_string(lo[2]) +
+                 R"(],"max":[)" + std::to_string(hi[0]) + "," + std::to_string(hi[1]) + "," +
+                 std::to_string(hi[2]) + "]}";
+    primitives += sep + R"({"attributes":{"POSITION":)" + n + R"(},"material":)" +
+                  std::to_string(k.material) + "}";
+  }
+  std::ofstream(dir / (name + ".bin"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size() * 4));
+  std::ofstream(dir / (name + ".gltf"))
+      << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1,2]}],)"
+      << R"("nodes":[{"mesh":0},{"camera":0,"translation":[0,0.8,3.5]},)"
+      << R"({"translation":[0.5,1,1],"extensions":{"KHR_lights_punctual":{"light":0}}}],)"
+      << R"("cameras":[{"type":"perspective","perspective":{"yfov":0.8,"znear":0.01}}],)"
+      << R"("meshes":[{"primitives":[)" << primitives << "]}],"
+      << R"("accessors":[)" << accessors << R"(],"bufferViews":[)" << views << "],"
+      << R"("buffers":[{"byteLength":)" << data.size() * 4 << R"(,"uri":")" << name << R"(.bin"}],)"
+      << R"("extensionsUsed":["KHR_materials_emissive_strength","KHR_materials_ior",)"
+      << R"("KHR_materials_transmission","KHR_materials_volume","KHR_lights_punctual"],)"
+      << R"("materials":[)" << materials << "],"
+      << R"("extensions":{"KHR_lights_punctual":{"lights":[)" << light << "]}}}";
+  return name + ".gltf";
+}
+
+// A Radiance .hdr of 8 x 4 flat RGBE pixels, each (m, m, m) x 2^(e - 136).
+void write_hdr(const fs::path& path, unsigned char m, unsigned char e) {
+  std::ofstream out(path, std::ios::binary);
+  out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
+  for (int i = 0; i < 32; ++i) out << m << m << m << e;
+}
+
+// Values glTF allows that float32 cannot carry through the transport: an emissive strength of
+// 3.4e38 (x emissiveFactor), an ior of 1e39 (beyond float32: read as FLT_MAX), a light of
+// intensity 1e38, an attenuationDistance of 1e-38 and an environment map of texels 1.7e38 (RGBE's
+// largest). Clamped on load (to 2^64 radiance and an ior of 2^16, scene.h), each with one warning
+// naming the element; the render drops no sample as NaN/Inf and its image is finite. Before:
+// 1584 of 49152 samples were NaN/Inf without the map, tens of thousands with it.
+TEST_F(EdgeCli, ValuesBeyondFloat32AreClampedAndRenderFinite) {
+  const std::string materials =
+      R"({"doubleSided":true},)"
+      R"({"emissiveFactor":[1,0.5,1],"extensions":{"KHR_materials_emissive_strength":)"
+      R"({"emissiveStrength":3.4e38}}},)"
+      R"({"doubleSided":true,"pbrMetallicRoughness":{"roughnessFactor":0.2},"extensions":{)"
+      R"("KHR_materials_ior":{"ior":1e39},"KHR_materials_transmission":{"transmissionFactor":1},)"
+      R"("KHR_materials_volume":{"thicknessFactor":1}}},)"
+      R"({"doubleSided":true,"extensions":{"KHR_materials_transmission":{"transmissionFactor":1},)"
+      R"("KHR_materials_volume":{"thicknessFactor":1,"attenuationDistance":1e-38,)"
+      R"("attenuationColor":[0.5,0.9,0.1]}}},)"
+      R"({"doubleSided":true,"pbrMetallicRoughness":{"metallicFactor":1,"roughnessFactor":0.05}})";
+  const std::vector<Quad> quads = {{{-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, 0},
+                                   {{-0.3f, 1.5f, 0.3f}, {0, 0, -0.6f}, {0.6f, 0, 0}, 1},
+                                   {{-1, 0.2f, 0.5f}, {1, 0, 0}, {0, 1, 0}, 2},
+                                   {{0, 0.2f, 0.6f}, {1, 0, 0}, {0, 1, 0}, 3},
+                                   {{-2, 0, -1.5f}, {4, 0, 0}, {0, 2, 0}, 4}};
+  const std::string scene = quads_gltf(dir_, "extreme", quads, materials,
+                                       R"({"type":"point","color":[1,1,0.5],"intensity":1e38})");
+  write_hdr(dir_ / "sky.hdr", 255, 255);
+  const CliRun r =
+      run("render " + scene + " --env sky.hdr --width 64 --height 48 --spp 16 --json -o out.exr");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(wp::test::json_number(r.out, "nonfinite_samples"), 0) << r.out;
+  EXPECT_EQ(r.err.find("NaN"), std::string::npos) << r.err;
+  for (const char* warning :
+       {"wavepath: warning: extreme.gltf: material 1 '': emission 3.4e+38 clamped to 1.84467e+19",
+        "wavepath: warning: extreme.gltf: material 2 '': ior 3.40282e+38 clamped to 65536",
+        "wavepath: warning: extreme.gltf: light 0 '': intensity 1e+38 clamped to 1.84467e+19",
+        "wavepath: warning: sky.hdr: 32 texels above 1.84467e+19 (the brightest 1.69477e+38) "
+        "clamped to it"})
+    EXPECT_NE(r.err.find(warning), std::string::npos) << warning << "\n" << r.err;
+  const wp::ImageRgb image = wp::read_exr((dir_ / "out.exr").string());
+  ASSERT_EQ(image.rgb.size(), 64u * 48u * 3u);
+  for (const float v : image.rgb) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
+
+  // Options are not clamped but refused: a map at the limit cannot be made brighter, nor can the
+  // background exceed it.
+  expect_error(
+      run("render " + scene + " --env sky.hdr --env-intensity 2 -o out.exr"),
+      "--env-intensity 2: the map's brightest texel (1.84467e+19) times it must be at most",
+      "--env-intensity");
+  expect_error(run("render " + scene + " --env-color 1e30,0,0 -o out.exr"),
+               "--env-color must be at most the most radiance wavepath carries", "--env-color");
 }
 
 }  // namespace

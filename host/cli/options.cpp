@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -425,9 +426,14 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   wp::validate(settings);
   settings.env_filter =
       cli.env_filter == "nearest" ? wp::EnvFilter::kNearest : wp::EnvFilter::kBilinear;
-  if (!cli.env.empty())
+  if (!cli.env.empty()) {
     settings.environment =
         std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env, settings.env_filter));
+    wp::validate(settings);  // --env-intensity against the map's brightest texel
+    if (!cli.quiet && ranks.root())
+      for (const auto& w : settings.environment->warnings)
+        std::fprintf(stderr, "wavepath: warning: %s\n", w.c_str());
+  }
 }
 
 }  // namespace wp::cli

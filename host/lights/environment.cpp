@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <utility>
@@ -15,6 +16,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 
+#include "host/scene/scene.h"
 #include "host/util/error.h"
 #include "host/util/files.h"
 
@@ -337,6 +339,27 @@ void read_exr(const std::string& path, EnvironmentMap& env) {
   }
 }
 
+// Texels brighter than float32 carries through the transport (scene.h: kMaxRadiance) are clamped
+// to it, all three channels scaled alike; one warning says how many and the brightest.
+void clamp_radiance(EnvironmentMap& env) {
+  std::size_t count = 0;
+  float brightest = 0.0f;
+  for (glm::vec4& t : env.texels) {
+    const float m = std::max({t.x, t.y, t.z});
+    if (!std::isfinite(m) || m <= float(kMaxRadiance)) continue;  // NaN, Inf: validate's errors
+    ++count;
+    brightest = std::max(brightest, m);
+    t = glm::vec4(glm::vec3(t) * (float(kMaxRadiance) / m), t.w);
+  }
+  if (count == 0) return;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                ": %zu texel%s above %g (the brightest %g) clamped to it, the most radiance "
+                "wavepath carries",
+                count, count == 1 ? "" : "s", kMaxRadiance, double(brightest));
+  env.warnings.push_back(env.source + text);
+}
+
 // Refuses what would poison the tables or the image: wrong sizes, NaN, infinities, negatives.
 void validate(const EnvironmentMap& env) {
   const std::string name = env.source.empty() ? std::string("environment map") : env.source;
@@ -394,6 +417,7 @@ EnvironmentMap load_environment(const std::string& path, EnvFilter filter) {
     read_hdr(path, env);
   else
     read_exr(path, env);
+  clamp_radiance(env);
   build_environment_tables(env, filter);
   return env;
 }
@@ -409,7 +433,12 @@ void build_environment_tables(EnvironmentMap& env, EnvFilter filter) {
   env.filter = filter;
   const std::size_t w = std::size_t(env.width), h = std::size_t(env.height);
   std::vector<double> lum(w * h);
-  for (std::size_t i = 0; i < w * h; ++i) lum[i] = luminance(env.texels[i]);
+  env.max_radiance = 0.0;
+  for (std::size_t i = 0; i < w * h; ++i) {
+    lum[i] = luminance(env.texels[i]);
+    const glm::vec4& t = env.texels[i];
+    env.max_radiance = std::max({env.max_radiance, double(t.x), double(t.y), double(t.z)});
+  }
   std::vector<double> bound = lum;
   if (filter == EnvFilter::kBilinear)
     for (std::size_t y = 0; y < h; ++y)

@@ -9,6 +9,7 @@
 #include "host/accel/bvh_cache.h"
 #include "host/accel/bvh_input.h"
 #include "host/device/device_scene.h"
+#include "host/scene/gltf_values.h"
 #include "host/util/error.h"
 #include "host/util/files.h"
 #include "host/util/fnv1a.h"
@@ -41,6 +42,16 @@ void validate(const RenderSettings& s) {
   for (int i = 0; i < 3; ++i)
     check(std::isfinite(s.background[i]) && s.background[i] >= 0.0f,
           "--env-color must be three finite, non-negative numbers");
+  // Radiance beyond what float32 carries through the transport (scene.h).
+  const std::string limit = " (" + gltf::number_text(kMaxRadiance) + " = 2^64)";
+  for (int i = 0; i < 3; ++i)
+    check(s.background[i] <= kMaxRadiance,
+          "--env-color must be at most the most radiance wavepath carries" + limit);
+  if (s.environment)
+    check(double(s.env_intensity) * s.environment->max_radiance <= kMaxRadiance,
+          "--env-intensity " + gltf::number_text(s.env_intensity) +
+              ": the map's brightest texel (" + gltf::number_text(s.environment->max_radiance) +
+              ") times it must be at most the most radiance wavepath carries" + limit);
   check_view(s.view, s.camera >= 0);
 }
 

@@ -340,7 +340,9 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
     }
     if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
     const int light = gltf::node_light(node, node_index);
-    if (light >= 0) scene_.lights.push_back(gltf::make_light(model_, light, world));
+    std::vector<std::string> clamped;
+    if (light >= 0) scene_.lights.push_back(gltf::make_light(model_, light, world, &clamped));
+    for (const std::string& w : clamped) scene_.warnings.push_back(scene_.source + ": " + w);
   } catch (const Error& e) {
     throw Error(where + e.what());
   }
@@ -523,8 +525,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
       scene.digest = fnv1a64(tag.data(), tag.size(), scene.digest);
     }
     gltf::TextureTable textures(model, scene);
+    std::vector<std::string> clamped;  // values beyond what float32 carries (scene.h)
     for (std::size_t i = 0; i < model.materials.size(); ++i)
-      scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i), textures));
+      scene.materials.push_back(
+          gltf::convert_material(model, static_cast<int>(i), textures, &clamped));
+    for (const std::string& w : clamped) scene.warnings.push_back(path + ": " + w);
     SceneBuilder(model, scene, variant).build(scene_index);
     // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
     if (scene.triangle_count() == 0)

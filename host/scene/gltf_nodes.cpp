@@ -1,5 +1,6 @@
 #include "host/scene/gltf_nodes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -115,7 +116,8 @@ int node_light(const tinygltf::Node& node, int index) {
   return ext.Get("light").GetNumberAsInt();
 }
 
-PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world) {
+PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world,
+                         std::vector<std::string>* warnings) {
   if (index < 0 || static_cast<std::size_t>(index) >= model.lights.size())
     throw Error("light " + std::to_string(index) + " does not exist");
   const tinygltf::Light& in = model.lights[static_cast<std::size_t>(index)];
@@ -135,7 +137,12 @@ PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dma
   if (present(in.color, 3, where, "color"))
     for (int i = 0; i < 3; ++i)
       color[i] = in_range(in.color[static_cast<std::size_t>(i)], 0.0, 1.0, where, "color");
-  out.intensity = color * in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
+  const double intensity = in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
+  const double brightest = intensity * std::max({color.x, color.y, color.z});
+  const double scale = at_most(brightest, kMaxRadiance, where, "intensity",
+                               "colour x intensity; the most radiance wavepath carries", warnings) /
+                       std::max(brightest, 1e-300);
+  out.intensity = glm::vec3(glm::dvec3(color) * intensity * scale);
   out.range = finite(in.range, where, "range");  // tinygltf: 0 when absent (no range)
   require(in.range >= 0.0, where, "range", "> 0", in.range);
   // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out; the

@@ -164,4 +164,46 @@ TEST(GltfBounds, EachSchemaRuleAcceptsInsideAndRefusesOutside) {
   }
 }
 
+// Values glTF allows but float32 cannot carry through the transport are clamped, one warning per
+// element naming it: emission (factor x strength, the colour kept) and a light's colour x
+// intensity to 2^64, an index of refraction to 2^16 (scene.h); 1e39, beyond float32, reads as
+// FLT_MAX. Values at the limits load as they are, without a warning.
+TEST(GltfBounds, ValuesBeyondFloat32AreClampedWithAWarning) {
+  const auto load = [](const std::string& material, const std::string& intensity,
+                       const std::string& name) {
+    Gltf g = one_triangle("");
+    g.materials = {material};
+    g.top = R"("extensionsUsed":["KHR_lights_punctual"])";
+    g.lights = {R"({"type":"point","color":[1,0.5,0],"intensity":)" + intensity + "}"};
+    g.node(R"("extensions":{"KHR_lights_punctual":{"light":0}})", true);
+    return wp::load_gltf(g.write(name));
+  };
+  const double limit = wp::kMaxRadiance;
+  const wp::Scene s =
+      load(R"({"emissiveFactor":[1,0.5,0],"extensions":{"KHR_materials_emissive_strength":)"
+           R"({"emissiveStrength":3.4e38},"KHR_materials_ior":{"ior":1e39},)"
+           R"("KHR_materials_iridescence":{"iridescenceFactor":1,"iridescenceIor":1e30}}})",
+           "1e38", "clamped.gltf");
+  EXPECT_EQ(s.materials[0].emission, glm::vec3(float(limit), float(limit / 2), 0.0f));
+  EXPECT_EQ(s.materials[0].ior, float(wp::kMaxIor));
+  EXPECT_EQ(s.materials[0].iridescence_ior, float(wp::kMaxIor));
+  EXPECT_EQ(s.lights[0].intensity, glm::vec3(float(limit), float(limit / 2), 0.0f));
+  const std::vector<std::string> expected = {
+      "material 0 '': emission 3.4e+38 clamped to 1.84467e+19",
+      "material 0 '': ior 3.40282e+38 clamped to 65536",
+      "material 0 '': iridescenceIor 1e+30 clamped to 65536",
+      "light 0 '': intensity 1e+38 clamped to 1.84467e+19"};
+  ASSERT_EQ(s.warnings.size(), expected.size()) << join(s.warnings);
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    EXPECT_NE(s.warnings[i].find(expected[i]), std::string::npos) << s.warnings[i];
+
+  const wp::Scene at =
+      load(R"({"emissiveFactor":[1,1,1],"extensions":{)"
+           R"("KHR_materials_emissive_strength":{"emissiveStrength":1.8446744e19},)"
+           R"("KHR_materials_ior":{"ior":65536}}})",
+           "1.8446744e19", "at_limits.gltf");
+  EXPECT_TRUE(at.warnings.empty()) << join(at.warnings);
+  EXPECT_EQ(at.materials[0].ior, 65536.0f);
+}
+
 }  // namespace
