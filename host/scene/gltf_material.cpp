@@ -10,6 +10,10 @@
 namespace wp::gltf {
 namespace {
 
+// Why an index of refraction above kMaxIor (scene.h) is clamped, for the warning.
+constexpr const char* kIorLimit =
+    "the largest index of refraction float32 carries through the transport";
+
 // The object of material extension `name`, or null when the material does not use it. (tinygltf
 // drops extension values that are not objects, and empty arrays and objects inside them: such
 // fields read as absent.)
@@ -144,10 +148,7 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
   require(in.alphaCutoff >= 0.0, where, "alphaCutoff", ">= 0", in.alphaCutoff);
   out.ior = extension_number(in, "KHR_materials_ior", "ior", 1.5f, where);
   require(out.ior == 0.0f || out.ior >= 1.0f, where, "ior", "0 or >= 1", out.ior);
-  out.ior = float(at_most(out.ior, kMaxIor, where, "ior",
-                          "the largest index of refraction float32 "
-                          "carries through the transport",
-                          warnings));
+  out.ior = float(at_most(out.ior, kMaxIor, where, "ior", kIorLimit, warnings));
   out.transmission = in_range(
       extension_number(in, "KHR_materials_transmission", "transmissionFactor", 0.0f, where), 0.0,
       1.0, where, "transmissionFactor");
@@ -213,10 +214,9 @@ void read_iridescence(const tinygltf::Material& in, const std::string& where,
   const char* kName = "KHR_materials_iridescence";
   const tinygltf::Value* ext = extension(in, kName, where);
   out.iridescence = number_in(ext, kName, "iridescenceFactor", 0.0f, 0.0, 1.0, where);
-  out.iridescence_ior = float(
-      at_most(number_in(ext, kName, "iridescenceIor", 1.3f, 1.0, INFINITY, where), kMaxIor, where,
-              "iridescenceIor",
-              "the largest index of refraction float32 carries through the transport", warnings));
+  out.iridescence_ior =
+      float(at_most(number_in(ext, kName, "iridescenceIor", 1.3f, 1.0, INFINITY, where), kMaxIor,
+                    where, "iridescenceIor", kIorLimit, warnings));
   out.iridescence_thickness_min =
       number_in(ext, kName, "iridescenceThicknessMinimum", 100.0f, 0.0, INFINITY, where);
   out.iridescence_thickness_max =
