@@ -271,20 +271,23 @@ TEST(PackedSize, RenderRefusesBeforeBuildingTheBvh) {
 // A packed scene beyond what will hold it is refused, naming both sizes, instead of an allocation
 // failure or (on a CPU device, where it is host memory) the system killing the process: a GPU's
 // global memory, a CPU device's available host memory (0: unknown, not checked).
+// The message of the wp::Error `f` throws; "" when it throws none.
+template <typename F>
+std::string error(const F& f) {
+  try {
+    f();
+  } catch (const wp::Error& e) {
+    return std::string(e.what());
+  }
+  return std::string();
+}
+
 TEST(PackedSize, SceneMemoryIsChecked) {
   DeviceEntry cpu, gpu;
   cpu.name = "cpu";
   gpu.name = "gpu";
   gpu.gpu = true;
   gpu.global_memory = 4'000'000'000ull;
-  const auto error = [](const auto& f) {
-    try {
-      f();
-    } catch (const wp::Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   EXPECT_EQ(error([&] { check_scene_memory(4'000'000'000ull, cpu, 4'000'000'000ull); }), "");
   EXPECT_EQ(error([&] { check_scene_memory(1ull << 40, cpu, 0); }), "");
   EXPECT_EQ(error([&] { check_scene_memory(8'000'000'000ull, cpu, 4'500'000'000ull); }),
@@ -293,6 +296,35 @@ TEST(PackedSize, SceneMemoryIsChecked) {
   EXPECT_EQ(error([&] { check_scene_memory(4'000'000'000ull, gpu, 1); }), "");
   EXPECT_EQ(error([&] { check_scene_memory(5'000'000'000ull, gpu, 1ull << 40); }),
             "scene too large for the device: it packs into 5.00 GB, gpu has 4.00 GB");
+}
+
+// An image whose film (or other path-state buffer) the device cannot allocate is refused before
+// anything is, naming the image, the bytes needed and the device's limit: one buffer beyond
+// CL_DEVICE_MAX_MEM_ALLOC_SIZE, or all of them beyond CL_DEVICE_GLOBAL_MEM_SIZE.
+TEST(PackedSize, ImageMemoryIsChecked) {
+  DeviceEntry device;
+  device.name = "dev";
+  device.max_alloc = 1ull << 31;
+  device.global_memory = 3ull << 30;
+  RenderSettings s;
+  const SceneFeatures features = SceneFeatures::all();
+  s.width = s.height = 4096;  // 16 Mi pixels x 96 bytes: 1.5 GiB of film
+  EXPECT_EQ(error([&] { check_state_memory(state_memory(s, features), s, device); }), "");
+  s.width = 5461;  // 5461 x 4096 x 96 bytes: just under 2 GiB
+  EXPECT_EQ(error([&] { check_state_memory(state_memory(s, features), s, device); }), "");
+  s.width = 5462;  // just over
+  EXPECT_EQ(error([&] { check_state_memory(state_memory(s, features), s, device); }),
+            "image too large for the device: 5462 x 4096 needs a film buffer of 2147745792 bytes "
+            "(2.00 GiB), more than the 2147483648 bytes (2.00 GiB) dev allocates at once "
+            "(CL_DEVICE_MAX_MEM_ALLOC_SIZE)");
+  device.max_alloc = 0;  // unknown: only the total is checked
+  s.width = s.height = 16384;
+  const StateMemory m = state_memory(s, features);
+  EXPECT_EQ(error([&] { check_state_memory(m, s, device); }),
+            "image too large for the device: 16384 x 16384 needs " + std::to_string(m.total()) +
+                " bytes (" + human_bytes(m.total()) +
+                ") of path state, queues and film, more than the 3221225472 bytes (3.00 GiB) of "
+                "dev (CL_DEVICE_GLOBAL_MEM_SIZE)");
 }
 
 // The kernels find every array wherever it lies: a textured, lit scene with an environment map,

@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -32,15 +33,10 @@ void check_outputs(const std::vector<std::string>& outputs) {
     const std::string ext = extension_of(o);
     if (ext != ".exr" && ext != ".png" && ext != ".pfm" && ext != ".wpfilm")
       throw wp::Error(o + ": unsupported output format (use .exr, .png, .pfm or .wpfilm)");
-    const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
-    if (!std::filesystem::is_directory(dir))
-      throw wp::Error(o + ": folder " + dir.string() + " does not exist");
-    if (access(dir.c_str(), W_OK | X_OK) != 0)
-      throw wp::Error(o + ": folder " + dir.string() + " is not writable (" + std::strerror(errno) +
-                      ")");
     std::error_code ec;
     const auto status = std::filesystem::symlink_status(p, ec);
     if (std::filesystem::is_directory(status)) throw wp::Error(o + ": is a directory");
+    wp::check_output_folder(o);  // by creating a file there: access(2) says yes to root
     if (std::filesystem::exists(status) && access(p.c_str(), W_OK) != 0)
       throw wp::Error(o + ": the existing file is not writable (" + std::strerror(errno) + ")");
   }
@@ -437,9 +433,14 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   settings.env_filter =
       cli.env_filter == "nearest" ? wp::EnvFilter::kNearest : wp::EnvFilter::kBilinear;
   settings.mipmaps = cli.mipmaps == "on";
-  if (!cli.env.empty())
+  if (!cli.env.empty()) {
     settings.environment =
         std::make_shared<wp::EnvironmentMap>(wp::load_environment(cli.env, settings.env_filter));
+    wp::validate(settings);  // --env-intensity against the map's brightest texel
+    if (!cli.quiet && ranks.root())
+      for (const auto& w : settings.environment->warnings)
+        std::fprintf(stderr, "wavepath: warning: %s\n", w.c_str());
+  }
 }
 
 }  // namespace wp::cli

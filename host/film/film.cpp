@@ -27,6 +27,7 @@
 #include "host/util/error.h"
 #include "host/film/film_header.h"
 #include "host/util/fnv1a.h"
+#include "host/util/files.h"
 #include "host/util/json.h"
 
 namespace wp {
@@ -296,10 +297,8 @@ struct OpenedFilm {
 
 OpenedFilm open_film(const std::string& path) {
   const auto fail = [&](const std::string& what) { return Error(path + ": " + what); };
+  require_regular_file(path);  // a FIFO must not block fopen
   std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) throw fail("no such file");
-  if (!std::filesystem::is_regular_file(status)) throw fail("not a regular file");
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   if (ec) throw fail("cannot read: " + ec.message());
   OpenedFilm o;

@@ -4,14 +4,11 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <system_error>
 #include <utility>
 
 #include <ImfChannelList.h>
@@ -19,7 +16,9 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 
+#include "host/scene/scene.h"
 #include "host/util/error.h"
+#include "host/util/files.h"
 
 namespace wp {
 
@@ -178,12 +177,7 @@ class RgbeReader {
 };
 
 void read_hdr(const std::string& path, EnvironmentMap& env) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                   std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(path + ": read failed: " + std::strerror(errno));
-  RgbeReader(path, std::move(bytes)).read(env);
+  RgbeReader(path, read_regular_file(path)).read(env);
 }
 
 // A data window of w x h pixels, checked before anything is allocated for it: a 417-byte file can
@@ -243,9 +237,7 @@ std::size_t exr_fixed_size(const std::string& type) {
 // file's headers with an empty header. A dataWindow is checked here too (check_exr_window): for a
 // window millions of pixels wide OpenEXR allocates line buffers before read_exr could look.
 void check_exr_attributes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)),
-                               std::istreambuf_iterator<char>());
+  const std::vector<unsigned char> b = read_regular_file(path);
   const auto fail = [&](const std::string& what) {
     return Error(path + ": the EXR header is corrupt (" + what + ")");
   };
@@ -347,6 +339,27 @@ void read_exr(const std::string& path, EnvironmentMap& env) {
   }
 }
 
+// Texels brighter than float32 carries through the transport (scene.h: kMaxRadiance) are clamped
+// to it, all three channels scaled alike; one warning says how many and the brightest.
+void clamp_radiance(EnvironmentMap& env) {
+  std::size_t count = 0;
+  float brightest = 0.0f;
+  for (glm::vec4& t : env.texels) {
+    const float m = std::max({t.x, t.y, t.z});
+    if (!std::isfinite(m) || m <= float(kMaxRadiance)) continue;  // NaN, Inf: validate's errors
+    ++count;
+    brightest = std::max(brightest, m);
+    t = glm::vec4(glm::vec3(t) * (float(kMaxRadiance) / m), t.w);
+  }
+  if (count == 0) return;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                ": %zu texel%s above %g (the brightest %g) clamped to it, the most radiance "
+                "wavepath carries",
+                count, count == 1 ? "" : "s", kMaxRadiance, double(brightest));
+  env.warnings.push_back(env.source + text);
+}
+
 // Refuses what would poison the tables or the image: wrong sizes, NaN, infinities, negatives.
 void validate(const EnvironmentMap& env) {
   const std::string name = env.source.empty() ? std::string("environment map") : env.source;
@@ -399,12 +412,12 @@ EnvironmentMap load_environment(const std::string& path, EnvFilter filter) {
   const std::string ext = lower_extension(path);
   if (ext != ".hdr" && ext != ".exr")
     throw Error(path + ": unsupported environment map format (use .hdr or .exr)");
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": no such file");
+  require_regular_file(path);  // a FIFO must not block OpenEXR's open
   if (ext == ".hdr")
     read_hdr(path, env);
   else
     read_exr(path, env);
+  clamp_radiance(env);
   build_environment_tables(env, filter);
   return env;
 }
@@ -420,7 +433,12 @@ void build_environment_tables(EnvironmentMap& env, EnvFilter filter) {
   env.filter = filter;
   const std::size_t w = std::size_t(env.width), h = std::size_t(env.height);
   std::vector<double> lum(w * h);
-  for (std::size_t i = 0; i < w * h; ++i) lum[i] = luminance(env.texels[i]);
+  env.max_radiance = 0.0;
+  for (std::size_t i = 0; i < w * h; ++i) {
+    lum[i] = luminance(env.texels[i]);
+    const glm::vec4& t = env.texels[i];
+    env.max_radiance = std::max({env.max_radiance, double(t.x), double(t.y), double(t.z)});
+  }
   std::vector<double> bound = lum;
   if (filter == EnvFilter::kBilinear)
     for (std::size_t y = 0; y < h; ++y)

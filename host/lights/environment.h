@@ -30,11 +30,15 @@ struct EnvironmentMap {
   EnvFilter filter = EnvFilter::kNearest;  // the lookup the tables were built for
   // Mean radiance luminance over the sphere (solid-angle weighted), for light selection by power.
   double mean_luminance = 0.0;
+  double max_radiance = 0.0;  // the largest texel channel (--env-intensity's limit)
+  // What loading changed, one line each (texels beyond kMaxRadiance clamped to it).
+  std::vector<std::string> warnings;
 };
 
-// Loads an equirectangular map. Throws wp::Error naming the file when it is missing, unreadable,
-// of an unsupported format, malformed or truncated, larger than 2^28 texels, or holds non-finite or
-// negative values.
+// Loads an equirectangular map. Throws wp::Error naming the file when it is missing, not a regular
+// file, unreadable, of an unsupported format, malformed or truncated, larger than 2^28 texels, or
+// holds non-finite or negative values. Texels above scene.h's kMaxRadiance (a .hdr holds up to
+// 1.7e38) are clamped to it, with a warning in env.warnings.
 EnvironmentMap load_environment(const std::string& path, EnvFilter filter = EnvFilter::kNearest);
 
 // Builds the sampling tables for `filter` (and sets env.filter) and mean_luminance (the nearest

@@ -9,6 +9,7 @@
 #include "host/accel/bvh_cache.h"
 #include "host/accel/bvh_input.h"
 #include "host/device/device_scene.h"
+#include "host/scene/gltf_values.h"
 #include "host/util/error.h"
 #include "host/util/files.h"
 #include "host/util/fnv1a.h"
@@ -41,6 +42,16 @@ void validate(const RenderSettings& s) {
   for (int i = 0; i < 3; ++i)
     check(std::isfinite(s.background[i]) && s.background[i] >= 0.0f,
           "--env-color must be three finite, non-negative numbers");
+  // Radiance beyond what float32 carries through the transport (scene.h).
+  const std::string limit = " (" + gltf::number_text(kMaxRadiance) + " = 2^64)";
+  for (int i = 0; i < 3; ++i)
+    check(s.background[i] <= kMaxRadiance,
+          "--env-color must be at most the most radiance wavepath carries" + limit);
+  if (s.environment)
+    check(double(s.env_intensity) * s.environment->max_radiance <= kMaxRadiance,
+          "--env-intensity " + gltf::number_text(s.env_intensity) +
+              ": the map's brightest texel (" + gltf::number_text(s.environment->max_radiance) +
+              ") times it must be at most the most radiance wavepath carries" + limit);
   check_view(s.view, s.camera >= 0);
 }
 
@@ -126,6 +137,26 @@ void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uin
                 gb(available) + " are available");
 }
 
+void check_state_memory(const StateMemory& memory, const RenderSettings& settings,
+                        const DeviceEntry& device) {
+  const std::string image =
+      std::to_string(settings.width) + " x " + std::to_string(settings.height);
+  const auto bytes = [](std::uint64_t b) {
+    return std::to_string(b) + " bytes (" + human_bytes(b) + ")";
+  };
+  const std::pair<const char*, std::uint64_t> buffers[] = {
+      {"film", memory.film}, {"path state", memory.path_state.bytes}, {"queue", memory.queues}};
+  for (const auto& [name, size] : buffers)
+    if (device.max_alloc && size > device.max_alloc)
+      throw Error("image too large for the device: " + image + " needs a " + name + " buffer of " +
+                  bytes(size) + ", more than the " + bytes(device.max_alloc) + " " + device.name +
+                  " allocates at once (CL_DEVICE_MAX_MEM_ALLOC_SIZE)");
+  if (device.global_memory && memory.total() > device.global_memory)
+    throw Error("image too large for the device: " + image + " needs " + bytes(memory.total()) +
+                " of path state, queues and film, more than the " + bytes(device.global_memory) +
+                " of " + device.name + " (CL_DEVICE_GLOBAL_MEM_SIZE)");
+}
+
 int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.bvh_width) return settings.bvh_width;
   return device.gpu ? 2 : 8;
@@ -143,7 +174,7 @@ bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings&
   std::vector<std::uint32_t> flags;
   const SceneCounts counts =
       scene_counts(scene, settings.environment.get(),
-                   render_features(scene, settings, settings.environment != nullptr).texture_lod);
+                   render_features(scene, settings).texture_lod);
   const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
   check_scene_memory(
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)
@@ -310,6 +341,8 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   const auto start = std::chrono::steady_clock::now();
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
+  check_state_memory(state_memory(settings, render_features(scene, settings)), settings,
+                     runtime.device());
   bool cached = false;
   const bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
   Wavefront wavefront(runtime, scene, bvh, settings);

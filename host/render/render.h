@@ -131,6 +131,13 @@ std::string render_key(const Scene& scene, const RenderSettings& settings, int b
 // otherwise kill the process for memory. render() checks with /proc/meminfo's MemAvailable.
 void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uint64_t available);
 
+// Fails (wp::Error naming the image size, the bytes needed and the device's limit) when the
+// buffers of `memory` cannot be allocated on `device`: one larger than CL_DEVICE_MAX_MEM_ALLOC_SIZE
+// (the film, mostly: 96 bytes a pixel, 208 with AOVs), or all of them together beyond
+// CL_DEVICE_GLOBAL_MEM_SIZE. render() checks before it allocates anything on the device.
+void check_state_memory(const StateMemory& memory, const RenderSettings& settings,
+                        const DeviceEntry& device);
+
 // Checks the ranges of user-facing settings; throws wp::Error naming the option.
 void validate(const RenderSettings& settings);
 

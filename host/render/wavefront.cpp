@@ -61,14 +61,6 @@ const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
 
 }  // namespace
 
-SceneFeatures render_features(const Scene& scene, const RenderSettings& settings,
-                              bool has_environment_map) {
-  SceneFeatures f =
-      settings.all_features ? SceneFeatures::all() : SceneFeatures::of(scene, has_environment_map);
-  if (!settings.mipmaps) f.texture_lod = false;
-  return f;
-}
-
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings) {
   if (settings.scene_buffer_bytes) return settings.scene_buffer_bytes;
   return device.max_alloc ? device.max_alloc : kSceneBufferReach;
@@ -94,6 +86,14 @@ StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& fe
   return m;
 }
 
+SceneFeatures render_features(const Scene& scene, const RenderSettings& settings) {
+  SceneFeatures f = settings.all_features
+                        ? SceneFeatures::all()
+                        : SceneFeatures::of(scene, settings.environment != nullptr);
+  if (!settings.mipmaps) f.texture_lod = false;
+  return f;
+}
+
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
     : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
@@ -111,7 +111,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     settings_.environment = std::move(rebuilt);
   }
   const EnvironmentMap* env = settings_.environment.get();
-  features_ = render_features(scene, settings, env != nullptr);
+  features_ = render_features(scene, settings);
   // Cache hints in the stages that read path state through a queue (kernels/features.h,
   // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
   // instruction and every address space is one.

@@ -102,12 +102,6 @@ constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 // The most bytes of one scene buffer on `device` with `settings`.
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
 
-// The kernel features a render of `scene` with `settings` builds: the scene's (or all of them with
-// all_features), without texture_lod under --mipmaps off. texture_lod also decides whether the
-// packed scene carries mip chains (SceneExtras::mipmaps, scene_counts).
-SceneFeatures render_features(const Scene& scene, const RenderSettings& settings,
-                              bool has_environment_map);
-
 // The paths of one wave for `settings` (RenderSettings::wave_size): `pixels` pixels, `samples`
 // samples of each.
 struct WaveShape {
@@ -127,6 +121,12 @@ struct StateMemory {
   std::uint64_t total() const { return path_state.bytes + queues + counters + film; }
 };
 StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features);
+
+// The kernel features a render of `scene` compiles in: all of them with settings.all_features,
+// else those the scene (and settings.environment) uses; without texture_lod under --mipmaps off.
+// texture_lod also decides whether the packed scene carries mip chains (SceneExtras::mipmaps,
+// scene_counts).
+SceneFeatures render_features(const Scene& scene, const RenderSettings& settings);
 
 // Wall-clock seconds of device execution per stage (only with RenderSettings::profile).
 struct StageTimes {

@@ -1,11 +1,11 @@
 #include "host/scene/gltf_loader.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <set>
@@ -20,6 +20,7 @@
 
 #include "host/scene/view.h"
 #include "host/util/error.h"
+#include "host/util/files.h"
 #include "host/util/fnv1a.h"
 #include "host/scene/gltf_extensions.h"
 #include "host/scene/gltf_material.h"
@@ -54,22 +55,35 @@ std::string one_line(const std::string& text) {
   return out.empty() ? "tinygltf gave no reason" : out;
 }
 
+// Below 4 GiB: tinygltf takes the length as 32 bits.
+constexpr std::uint64_t kMaxFileBytes = std::numeric_limits<std::uint32_t>::max() - 1;
+
 std::vector<unsigned char> read_file(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) throw Error(path + ": no such file");
-  if (std::filesystem::is_directory(status)) throw Error(path + ": is a directory");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
-  const std::streamoff size = in.tellg();
-  if (size <= 0) throw Error(path + ": empty file");
-  if (static_cast<std::uint64_t>(size) >= std::numeric_limits<std::uint32_t>::max())
-    throw Error(path + ": larger than 4 GiB, which glTF loading does not support");
-  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), size))
-    throw Error(path + ": read failed: " + std::strerror(errno));
+  std::vector<unsigned char> bytes = read_regular_file(path, kMaxFileBytes);
+  if (bytes.empty()) throw Error(path + ": empty file");
   return bytes;
+}
+
+// tinygltf's file access for the buffers and images a .gltf names by URI. Its own opens them
+// with fopen/ifstream, which block forever on a FIFO (in FileExists too): these stat first and
+// refuse anything but a regular file with a wp::Error naming it (parse() catches it).
+bool uri_file_exists(const std::string& path, void*) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+std::string uri_expand(const std::string& path, void*) {
+  return path;  // tinygltf's own does no expansion either (no ~ or variables in URIs)
+}
+
+bool uri_read(std::vector<unsigned char>* out, std::string*, const std::string& path, void*) {
+  *out = read_regular_file(path, kMaxFileBytes);
+  return true;
+}
+
+bool uri_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  *err = "wavepath does not write glTF files";
+  return false;
 }
 
 bool has_glb_magic(const std::vector<unsigned char>& b) {
@@ -143,6 +157,7 @@ tinygltf::Model parse(const std::string& path, std::vector<std::string>* warning
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&gltf::keep_encoded_image, nullptr);  // decoded when used (gltf_textures)
+  loader.SetFsCallbacks({&uri_file_exists, &uri_expand, &uri_read, &uri_write, nullptr});
   tinygltf::Model model;
   std::string err, warn;
   const std::string base = std::filesystem::path(path).parent_path().string();
@@ -325,7 +340,9 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
     }
     if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
     const int light = gltf::node_light(node, node_index);
-    if (light >= 0) scene_.lights.push_back(gltf::make_light(model_, light, world));
+    std::vector<std::string> clamped;
+    if (light >= 0) scene_.lights.push_back(gltf::make_light(model_, light, world, &clamped));
+    for (const std::string& w : clamped) scene_.warnings.push_back(scene_.source + ": " + w);
   } catch (const Error& e) {
     throw Error(where + e.what());
   }
@@ -508,8 +525,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
       scene.digest = fnv1a64(tag.data(), tag.size(), scene.digest);
     }
     gltf::TextureTable textures(model, scene);
+    std::vector<std::string> clamped;  // values beyond what float32 carries (scene.h)
     for (std::size_t i = 0; i < model.materials.size(); ++i)
-      scene.materials.push_back(gltf::convert_material(model, static_cast<int>(i), textures));
+      scene.materials.push_back(
+          gltf::convert_material(model, static_cast<int>(i), textures, &clamped));
+    for (const std::string& w : clamped) scene.warnings.push_back(path + ": " + w);
     SceneBuilder(model, scene, variant).build(scene_index);
     // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
     if (scene.triangle_count() == 0)

@@ -10,6 +10,10 @@
 namespace wp::gltf {
 namespace {
 
+// Why an index of refraction above kMaxIor (scene.h) is clamped, for the warning.
+constexpr const char* kIorLimit =
+    "the largest index of refraction float32 carries through the transport";
+
 // The object of material extension `name`, or null when the material does not use it. (tinygltf
 // drops extension values that are not objects, and empty arrays and objects inside them: such
 // fields read as absent.)
@@ -89,12 +93,41 @@ void read_volume(const tinygltf::Material& in, const std::string& where, Materia
       throw Error(where + ": attenuationColor needs 3 numbers");
     for (int i = 0; i < 3; ++i) {
       if (!c.Get(i).IsNumber()) throw Error(where + ": attenuationColor is not numbers");
-      out.attenuation_color[i] = finite(c.Get(i).GetNumberAsDouble(), where, "attenuationColor");
+      out.attenuation_color[i] =
+          in_range(c.Get(i).GetNumberAsDouble(), 0.0, 1.0, where, "attenuationColor");
     }
   }
 }
 
-void read_factors(const tinygltf::Material& in, const std::string& where, Material& out) {
+// Emission is emissiveFactor x emissive strength, in double: a strength near FLT_MAX is valid
+// glTF but no radiance float32 can carry through the transport (scene.h: kMaxRadiance).
+void read_emission(const tinygltf::Material& in, const std::string& where, Material& out,
+                   std::vector<std::string>* warnings) {
+  if (in.emissiveFactor.size() != 3)  // tinygltf fills [0, 0, 0] when absent
+    throw Error(where + ": emissiveFactor needs 3 numbers, has " +
+                std::to_string(in.emissiveFactor.size()));
+  const float strength =
+      extension_number(in, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f, where);
+  if (strength < 0.0f) throw Error(where + ": negative emissiveStrength");
+  double brightest = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double factor =
+        in_range(in.emissiveFactor[static_cast<std::size_t>(i)], 0.0, 1.0, where, "emissiveFactor");
+    brightest = std::max(brightest, factor * double(strength));
+  }
+  // One scale for the three channels keeps the colour.
+  const double scale = at_most(brightest, kMaxRadiance, where, "emission",
+                               "emissiveFactor x emissive strength; the most radiance wavepath "
+                               "carries",
+                               warnings) /
+                       std::max(brightest, 1e-300);
+  for (int i = 0; i < 3; ++i)
+    out.emission[i] = static_cast<float>(in.emissiveFactor[static_cast<std::size_t>(i)] *
+                                         double(strength) * scale);
+}
+
+void read_factors(const tinygltf::Material& in, const std::string& where, Material& out,
+                  std::vector<std::string>* warnings) {
   const tinygltf::PbrMetallicRoughness& pbr = in.pbrMetallicRoughness;
   if (pbr.baseColorFactor.size() != 4)
     throw Error(where + ": baseColorFactor needs 4 numbers, has " +
@@ -107,21 +140,15 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
   out.metallic = in_range(pbr.metallicFactor, 0.0, 1.0, where, "metallicFactor");
   out.roughness = in_range(pbr.roughnessFactor, 0.0, 1.0, where, "roughnessFactor");
 
-  if (in.emissiveFactor.size() != 3)  // tinygltf fills [0, 0, 0] when absent
-    throw Error(where + ": emissiveFactor needs 3 numbers, has " +
-                std::to_string(in.emissiveFactor.size()));
-  const float strength =
-      extension_number(in, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f, where);
-  if (strength < 0.0f) throw Error(where + ": negative emissiveStrength");
-  for (int i = 0; i < 3; ++i)
-    out.emission[i] = in_range(in.emissiveFactor[static_cast<std::size_t>(i)], 0.0, 1.0, where,
-                               "emissiveFactor") *
-                      strength;
+  read_emission(in, where, out, warnings);
 
   out.double_sided = in.doubleSided;
   out.alpha_mode = alpha_mode(in.alphaMode, where);
   out.alpha_cutoff = finite(in.alphaCutoff, where, "alphaCutoff");
+  require(in.alphaCutoff >= 0.0, where, "alphaCutoff", ">= 0", in.alphaCutoff);
   out.ior = extension_number(in, "KHR_materials_ior", "ior", 1.5f, where);
+  require(out.ior == 0.0f || out.ior >= 1.0f, where, "ior", "0 or >= 1", out.ior);
+  out.ior = float(at_most(out.ior, kMaxIor, where, "ior", kIorLimit, warnings));
   out.transmission = in_range(
       extension_number(in, "KHR_materials_transmission", "transmissionFactor", 0.0f, where), 0.0,
       1.0, where, "transmissionFactor");
@@ -183,11 +210,13 @@ void read_anisotropy(const tinygltf::Material& in, const std::string& where, Tex
 // KHR_materials_iridescence: a thin film of index iridescenceIor (at least 1) and a thickness
 // between the minimum and the maximum (nanometres, the maximum without a thickness texture).
 void read_iridescence(const tinygltf::Material& in, const std::string& where,
-                      TextureTable& textures, Material& out) {
+                      TextureTable& textures, Material& out, std::vector<std::string>* warnings) {
   const char* kName = "KHR_materials_iridescence";
   const tinygltf::Value* ext = extension(in, kName, where);
   out.iridescence = number_in(ext, kName, "iridescenceFactor", 0.0f, 0.0, 1.0, where);
-  out.iridescence_ior = number_in(ext, kName, "iridescenceIor", 1.3f, 1.0, INFINITY, where);
+  out.iridescence_ior =
+      float(at_most(number_in(ext, kName, "iridescenceIor", 1.3f, 1.0, INFINITY, where), kMaxIor,
+                    where, "iridescenceIor", kIorLimit, warnings));
   out.iridescence_thickness_min =
       number_in(ext, kName, "iridescenceThicknessMinimum", 100.0f, 0.0, INFINITY, where);
   out.iridescence_thickness_max =
@@ -244,20 +273,21 @@ Material default_material() {
   return m;  // Material's member defaults are glTF's
 }
 
-Material convert_material(const tinygltf::Model& model, int index, TextureTable& textures) {
+Material convert_material(const tinygltf::Model& model, int index, TextureTable& textures,
+                          std::vector<std::string>* warnings) {
   if (index < 0 || static_cast<std::size_t>(index) >= model.materials.size())
     throw Error("material " + std::to_string(index) + " does not exist");
   const tinygltf::Material& in = model.materials[static_cast<std::size_t>(index)];
   const std::string where = "material " + std::to_string(index) + " '" + in.name + "'";
   Material out;
   out.name = in.name;
-  read_factors(in, where, out);
+  read_factors(in, where, out, warnings);
   read_textures(in, where, textures, out);
   read_specular(in, where, textures, out);
   read_clearcoat(in, where, textures, out);
   read_sheen(in, where, textures, out);
   read_anisotropy(in, where, textures, out);
-  read_iridescence(in, where, textures, out);
+  read_iridescence(in, where, textures, out, warnings);
   out.dispersion = number_in(extension(in, "KHR_materials_dispersion", where),
                              "KHR_materials_dispersion", "dispersion", 0.0f, 0.0, INFINITY, where);
   read_diffuse_transmission(in, where, textures, out);

@@ -20,7 +20,10 @@ namespace wp::gltf {
 // line naming the material and the field, on malformed values, on factors outside their
 // extension's range (e.g. clearcoatFactor outside [0, 1], iridescenceIor below 1, a negative
 // dispersion) and on references to textures, images or samplers that do not exist.
-Material convert_material(const tinygltf::Model& model, int index, TextureTable& textures);
+// Values float32 cannot carry (an emission or an index of refraction beyond scene.h's limits) are
+// clamped, with a warning naming the material into `warnings` (may be null).
+Material convert_material(const tinygltf::Model& model, int index, TextureTable& textures,
+                          std::vector<std::string>* warnings = nullptr);
 
 // glTF's default material (spec 3.9.6): white, fully metallic and rough, opaque, single-sided.
 Material default_material();

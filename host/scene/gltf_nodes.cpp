@@ -1,5 +1,6 @@
 #include "host/scene/gltf_nodes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -72,21 +73,35 @@ Camera make_camera(const tinygltf::Model& model, int index, const glm::dmat4& wo
   const std::string where = "camera " + std::to_string(index) + " '" + in.name + "'";
   Camera out;
   out.name = in.name;
+  // glTF's schema: yfov, znear, aspectRatio and zfar > 0 and zfar > znear for a perspective
+  // camera; xmag and ymag not 0, znear >= 0, zfar > 0 and > znear for an orthographic one.
+  // tinygltf gives 0 for an absent aspectRatio or (perspective) zfar: only those present are read.
   if (in.type == "perspective") {
+    const tinygltf::PerspectiveCamera& p = in.perspective;
     out.type = CameraType::kPerspective;
-    out.yfov = finite(in.perspective.yfov, where, "yfov");
-    out.znear = finite(in.perspective.znear, where, "znear");
-    if (!(out.yfov > 0.0f && out.yfov < 3.14159f)) throw Error(where + ": yfov out of (0, pi)");
+    out.yfov = finite(p.yfov, where, "yfov");
+    out.znear = finite(p.znear, where, "znear");
+    require(p.yfov > 0.0, where, "yfov", "> 0", p.yfov);
+    require(out.yfov < 3.14159f, where, "yfov", "< pi", p.yfov);  // a pinhole sees less than 180
+    require(p.znear > 0.0, where, "znear", "> 0", p.znear);
+    require(finite(p.aspectRatio, where, "aspectRatio") >= 0.0f, where, "aspectRatio", "> 0",
+            p.aspectRatio);
+    if (finite(p.zfar, where, "zfar") != 0.0f)
+      require(p.zfar > p.znear, where, "zfar", "> znear", p.zfar);
   } else if (in.type == "orthographic") {
+    const tinygltf::OrthographicCamera& o = in.orthographic;
     out.type = CameraType::kOrthographic;
-    out.xmag = finite(in.orthographic.xmag, where, "xmag");
-    out.ymag = finite(in.orthographic.ymag, where, "ymag");
-    out.znear = finite(in.orthographic.znear, where, "znear");
-    if (out.xmag == 0.0f || out.ymag == 0.0f) throw Error(where + ": zero xmag or ymag");
+    out.xmag = finite(o.xmag, where, "xmag");
+    out.ymag = finite(o.ymag, where, "ymag");
+    out.znear = finite(o.znear, where, "znear");
+    require(o.xmag != 0.0, where, "xmag", "non-zero", o.xmag);
+    require(o.ymag != 0.0, where, "ymag", "non-zero", o.ymag);
+    require(o.znear >= 0.0, where, "znear", ">= 0", o.znear);
+    require(finite(o.zfar, where, "zfar") > 0.0f, where, "zfar", "> 0", o.zfar);
+    require(o.zfar > o.znear, where, "zfar", "> znear", o.zfar);
   } else {
     throw Error(where + ": unknown type '" + in.type + "'");
   }
-  if (out.znear < 0.0f) throw Error(where + ": negative znear");
   out.position = glm::vec3(world[3]);
   orientation(world, &out.forward, &out.up);
   return out;
@@ -101,7 +116,8 @@ int node_light(const tinygltf::Node& node, int index) {
   return ext.Get("light").GetNumberAsInt();
 }
 
-PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world) {
+PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world,
+                         std::vector<std::string>* warnings) {
   if (index < 0 || static_cast<std::size_t>(index) >= model.lights.size())
     throw Error("light " + std::to_string(index) + " does not exist");
   const tinygltf::Light& in = model.lights[static_cast<std::size_t>(index)];
@@ -121,8 +137,14 @@ PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dma
   if (present(in.color, 3, where, "color"))
     for (int i = 0; i < 3; ++i)
       color[i] = in_range(in.color[static_cast<std::size_t>(i)], 0.0, 1.0, where, "color");
-  out.intensity = color * in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
-  out.range = finite(in.range, where, "range");
+  const double intensity = in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
+  const double brightest = intensity * std::max({color.x, color.y, color.z});
+  const double scale = at_most(brightest, kMaxRadiance, where, "intensity",
+                               "colour x intensity; the most radiance wavepath carries", warnings) /
+                       std::max(brightest, 1e-300);
+  out.intensity = glm::vec3(glm::dvec3(color) * intensity * scale);
+  out.range = finite(in.range, where, "range");  // tinygltf: 0 when absent (no range)
+  require(in.range >= 0.0, where, "range", "> 0", in.range);
   // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out; the
   // extension asks 0 <= inner < outer <= pi/2.
   out.inner_cone = in_range(in.spot.innerConeAngle, 0.0, M_PI / 2, where, "innerConeAngle");

@@ -22,6 +22,9 @@ int node_light(const tinygltf::Node& node, int index);
 
 // Light `index` placed by `world`: position = world origin, direction = world -Z (unit),
 // intensity = colour x intensity.
-PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world);
+// Colour x intensity beyond scene.h's kMaxRadiance is clamped, with a warning into `warnings`
+// (may be null).
+PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dmat4& world,
+                         std::vector<std::string>* warnings = nullptr);
 
 }  // namespace wp::gltf

@@ -14,7 +14,7 @@ namespace wp::gltf {
 namespace {
 
 constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728,
-              kLinear = 9729;  // glTF sampler filters without mip-maps
+              kLinear = 9729;  // magnification filters, and minification without mip-maps
 
 std::string image_name(const tinygltf::Model& model, int index) {
   const tinygltf::Image& image = model.images[static_cast<std::size_t>(index)];
@@ -197,6 +197,13 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
     const std::string sampler_where = "sampler " + std::to_string(texture.sampler);
     ref.wrap_s = wrap_mode(s.wrapS, sampler_where, "wrapS");
     ref.wrap_t = wrap_mode(s.wrapT, sampler_where, "wrapT");
+    if (s.magFilter != -1 && s.magFilter != kNearest && s.magFilter != kLinear)
+      throw Error(sampler_where + ": unknown magFilter " + std::to_string(s.magFilter));
+    // minFilter: NEAREST, LINEAR, or one of the four *_MIPMAP_* modes 9984-9987 (trilinear
+    // here, whichever of them).
+    if (s.minFilter != -1 && s.minFilter != kNearest && s.minFilter != kLinear &&
+        !(s.minFilter >= 9984 && s.minFilter <= 9987))
+      throw Error(sampler_where + ": unknown minFilter " + std::to_string(s.minFilter));
     ref.nearest = s.magFilter == kNearest;
     ref.mipmaps = s.minFilter != kNearest && s.minFilter != kLinear;
   }

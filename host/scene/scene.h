@@ -23,6 +23,21 @@
 
 namespace wp {
 
+// What float32 carries through the transport (README, "Limits"); the loaders clamp larger values
+// with a warning. A sample's radiance is emitted radiance times a path's throughput and each
+// bounce's BSDF x cosine / pdf, which for sharp lobes and small, distant lights reach far above 1;
+// renders of extreme scenes (tests/test_cli_edges.cpp) stay finite with emission up to 2^110 or
+// so and give NaN/Inf samples from about 2^120 on (float32 ends at 2^128). Radiance at most
+// 2^64 leaves those factors 2^56 to 2^64; the film saturates a sample at 2^32 anyway
+// (kernels/shared/film.h), so only light that is dimmed on its way by that much more is lost.
+// The limit binds emission (emissiveFactor x emissive strength), punctual lights' colour x
+// intensity, environment texels and --env-intensity x the brightest texel, --env-color.
+constexpr double kMaxRadiance = 18446744073709551616.0;  // 2^64
+// An index of refraction: the kernels form eta^2 (radiance across an interface) and Fresnel's
+// ((eta - 1) / (eta + 1))^2, which at 1e39 (beyond float32) gives inf and NaN; at most 2^16 keeps
+// eta^2 x radiance within 2^96. (No material comes near: diamond 2.42.)
+constexpr double kMaxIor = 65536.0;  // 2^16
+
 enum class AlphaMode : std::uint8_t { kOpaque, kMask, kBlend };
 
 enum class Wrap : std::uint8_t { kRepeat, kClampToEdge, kMirroredRepeat };
