@@ -5,10 +5,11 @@
  *
  * Every path carries a cone about its ray: its width w at the ray's origin (world units) and its
  * spread angle g (radians, the cone's full angle; negative for a cone that converges), in the high
- * halves of the flags and bounce words (shared/path_state.def, path_state.h).
- *   camera      a pinhole starts with w = 0 and g = the pixel's angle, 2 tan(yfov / 2) / height;
- *               an orthographic camera with w = the pixel's height, 2 ymag / height, and g = 0.
- *               A thin lens keeps the pinhole's cone (its blur averages over more than a pixel).
+ * halves of the flags and bounce words (shared/path_state.def, path_state.h). The cone is an
+ * eighth (WP_CONE_SCALE) of the footprint one sample stands for, below.
+ *   camera      a pinhole starts with w = 0 and g = an eighth of the pixel's angle,
+ *               2 tan(yfov / 2) / height; an orthographic camera with w = an eighth of the pixel's
+ *               height, 2 ymag / height, and g = 0. A thin lens keeps the pinhole's cone.
  *   hit at t    w' = w + g t; the cone's footprint on the surface is |w'| / |cos| across, cos the
  *               angle between the ray and the geometric normal.
  *   level       lambda = log2(|w'| / |cos|) + 1/2 log2(A_uv / A_world) + 1/2 log2(W H |det T|):
@@ -18,12 +19,20 @@
  *               mip-maps).
  *   scattering  g' = g + 2 k w' for the surface's curvature k (below): a mirror on a sphere of
  *               radius R (k = 1/R) bends the rays across a footprint w' by 2 w'/R; plus, for a
- * sample of a lobe that is not delta, the full angle 2 / sqrt(pi pdf) of the cone whose solid angle
- * is 1 / pdf, the solid angle the sample stands for, at most pi: wide for a diffuse bounce (2 rad
- * at normal incidence), narrow for a glossy one, 0 for a mirror. Straight through a smooth
- * thin-walled transmitter the cone goes on unchanged. Emission and alpha are always looked up at
- * level 0 (textures.h), so that the light tables, light samples and shadow rays, which carry no
- * cone, see the same values as the paths. */
+ *               sample of a lobe that is not delta, an eighth of min(2 / sqrt(pi pdf), pi), the
+ *               full angle of the cone whose solid angle is 1 / pdf (the solid angle the sample
+ *               stands for): wide for a diffuse bounce (2 rad at normal incidence, so 0.25), narrow
+ *               for a glossy one, 0 for a mirror. Straight through a smooth thin-walled
+ *               transmitter the cone goes on unchanged.
+ * Why an eighth: the samples of a pixel are already spread over it (box filter) and each scattered
+ * sample's neighbours over its lobe, so a cone as wide as a whole footprint blurs the image twice
+ * over. Measured on DamagedHelmet seen small (tools/mip_study.py's case, 256 x 256, the model ~50
+ * pixels across, 1024 spp): the mip-mapped image converges to a relMSE of 0.0064 from the
+ * unfiltered one with whole footprints, 4.7e-4 with a quarter, 1.9e-4 with an eighth (pbrt-v4's
+ * smallest scale of its ray differentials too), while its relMSE at equal samples stays 1.3-1.6x
+ * below the unfiltered render's (docs/performance.md, "Mip-mapped textures: error against time").
+ * Emission and alpha are always looked up at level 0 (textures.h), so that the light tables,
+ * light samples and shadow rays, which carry no cone, see the same values as the paths. */
 #ifndef WP_RAY_CONE_H
 #define WP_RAY_CONE_H
 
@@ -42,9 +51,12 @@ static inline void path_set_cone_spread(Paths paths, uint slot, float spread) {
   path_set_flags_word(paths, slot, with_high_bf16(path_flags_word(paths, slot), spread));
 }
 
+/* The fraction of a sample's footprint the cone covers (above). */
+#define WP_CONE_SCALE 0.125f
+
 /* The camera's cone for a ray of an image `height` pixels high (Camera.up spans half of it). */
 static inline float2 camera_cone(const Camera* cam, uint height) {
-  const float pixel = 2.0f * length(cam->up.xyz) / (float)height;
+  const float pixel = WP_CONE_SCALE * 2.0f * length(cam->up.xyz) / (float)height;
   return cam->meta.x == WP_CAMERA_ORTHOGRAPHIC ? (float2)(pixel, 0.0f) : (float2)(0.0f, pixel);
 }
 
@@ -76,7 +88,7 @@ static inline float cone_spread_curved(float spread, float k, float width) {
 
 /* The spread a sample of solid-angle density pdf adds (0 for a delta lobe: pdf 0). */
 static inline float lobe_spread(float pdf) {
-  return pdf > 0.0f ? fmin(2.0f * rsqrt(M_PI_F * pdf), M_PI_F) : 0.0f;
+  return pdf > 0.0f ? WP_CONE_SCALE * fmin(2.0f * rsqrt(M_PI_F * pdf), M_PI_F) : 0.0f;
 }
 
 /* log2 of the cone's footprint at a hit, per texture coordinate set (x: TEXCOORD_0, y:

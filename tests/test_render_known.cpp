@@ -367,8 +367,8 @@ TEST_F(RenderKnown, EmptySceneShowsOnlyTheBackground) {
 }
 
 // A 2 x 2 square in the plane z = 0 facing +z, textured with a 64 x 64 checkerboard of black and
-// white texels (sRGB colour, magnification NEAREST, REPEAT) repeated 8 times across: 256 texels
-// per unit. Unlit (the image is the texture itself) or Lambertian.
+// white texels (sRGB colour, magnification NEAREST, REPEAT) repeated 32 times across: 1024
+// texels per unit. Unlit (the image is the texture itself) or Lambertian.
 wp::Scene checker_scene(bool unlit) {
   wp::Scene s;
   wp::Image img;
@@ -391,7 +391,7 @@ wp::Scene checker_scene(bool unlit) {
   s.materials.push_back(m);
   wp::test::add_quad(s, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, 0);
   for (std::size_t v = 0; v < 4; ++v)
-    s.uv0[v] = 4.0f * glm::vec2(s.positions[v].x + 1.0f, 1.0f - s.positions[v].y);
+    s.uv0[v] = 16.0f * glm::vec2(s.positions[v].x + 1.0f, 1.0f - s.positions[v].y);
   wp::test::finish_bounds(s);
   return s;
 }
@@ -415,15 +415,16 @@ double stored_half() {
   return wp::srgb_to_linear(std::round(255.0 * wp::linear_to_srgb(0.5)) / 255.0);
 }
 
-// Seen from 2.93 units the board spans 1.5 units (384 texels) over 48 pixels: a pixel covers 8 x 8
-// texels, and each camera ray's cone picks level ~3. With mip-maps every sample is
-// the stored half (the unlit image is that constant within float rounding, 1e-6), variance 0;
-// without, each sample is the texel under its jittered point, 0 or 1 with probability 1/2: the
-// image converges to 0.5, and each pixel's estimate has variance 0.25 / spp, which the mean of the
-// renderer's per-pixel variance estimates over 2304 pixels matches within 10% (their own relative
-// spread: sqrt(2 / 15) / 48 = 0.8%). Every mean over the 2304 pixels lies within 5 of its standard
-// errors of its known value. Lit (Lambertian under a white sky: radiance = albedo a times the
-// lighting estimate L, E[L] = 1, independent of a), the variance without mip-maps is E[a^2] E[L^2]
+// Seen from 2.93 units the board spans 1.5 units (1536 texels) over 48 pixels: a pixel covers 32 x
+// 32 texels, and each camera ray's cone (an eighth of the pixel) picks level 2 or a little more.
+// With mip-maps every sample is the stored half (the unlit image is that constant within float
+// rounding, 1e-6), variance 0; without, each sample is the texel under its jittered point, 0 or 1
+// with probability 1/2: the image converges to 0.5, and each pixel's estimate has variance 0.25 /
+// spp, which the mean of the renderer's per-pixel variance estimates over 2304 pixels matches
+// within 10% (their own relative spread: sqrt(2 / 15) / 48 = 0.8%). Every mean over the 2304 pixels
+// lies within 5 of its standard errors of its known value. Lit (Lambertian under a white sky:
+// radiance = albedo a times the lighting estimate L, E[L] = 1, independent of a), the variance
+// without mip-maps is E[a^2] E[L^2]
 // - E[a]^2 and with them a_h^2 (E[L^2] - 1), a_h the stored half: their difference is at least
 // var(a) = 0.25 per sample (the texture's share, which mip-maps remove), checked with 10% slack;
 // the ratio is printed (docs/usage.md quotes it).
@@ -453,15 +454,15 @@ TEST_F(RenderKnown, DistantCheckerboardShowsItsMeanWithMipmaps) {
       EXPECT_NEAR(mean_of(on.image), half, 5.0 * std::sqrt(var_on / n));
       EXPECT_GT(var_off - var_on, 0.9 * texture_share);
       std::printf(
-          "checkerboard at 8 texels per pixel, Lambertian, 16 spp: pixel variance "
+          "checkerboard at 32 texels per pixel, Lambertian, 16 spp: pixel variance "
           "%.3g with mip-maps, %.3g without (%.0fx)\n",
           var_on, var_off, var_off / var_on);
     }
   }
 }
 
-// Seen from 0.1 units the board spans 0.051 units (13 texels) over 48 pixels: magnified, each
-// ray's level is below 0 (about -1.9), so mip-mapped lookups are the full-resolution ones: the
+// Seen from 0.1 units the board spans 0.051 units (52 texels) over 48 pixels: magnified, each
+// ray's level is below 0 (about -2.9), so mip-mapped lookups are the full-resolution ones: the
 // same image bit for bit as without mip-maps, and the checks are sharp (NEAREST): pixels inside a
 // texel are exactly 0 or 1.
 TEST_F(RenderKnown, NearCheckerboardStaysSharpWithMipmaps) {

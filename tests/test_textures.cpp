@@ -753,15 +753,19 @@ TEST(TextureSample, LevelsMatchTrilinearReference) {
 // ---------------------------------------------------------------------------------------------
 // Ray cones (kernels/ray_cone.h)
 
+// kernels/ray_cone.h's WP_CONE_SCALE: cones are an eighth of a sample's footprint.
+constexpr double kConeScale = 0.125;
+
 // The level a camera ray's cone picks on a plane at a known distance and angle, against the
-// analytic footprint: a pinhole's cone spreads by the pixel's angle g = 2 tan(yfov / 2) / height,
+// analytic footprint: a pinhole's cone spreads by an eighth of the pixel's angle, g = 1/8 x
+// 2 tan(yfov / 2) / height,
 // so at distance t along the ray it is g t across, and g t / cos on a plane the ray meets at
 // angle theta to its normal; a texture of W x H texels spread over the plane with texel density
 // sqrt(W H |det T| A_uv / A_world) per unit length sees that footprint as log2 of (its length x
-// the density) texels: lambda. An orthographic camera's cone is the pixel's height 2 ymag /
-// height at any distance. Checked for several pixels of tilted views on both coordinate sets
-// (TEXCOORD_1 of the square covers twice the area of TEXCOORD_0) with a scaling transform;
-// tolerance 1e-4 (float log2 and the cone's arithmetic: relative errors of a few 1e-7).
+// the density) texels: lambda. An orthographic camera's cone is an eighth of the pixel's height,
+// 1/8 x 2 ymag / height, at any distance. Checked for several pixels of tilted views on both
+// coordinate sets (TEXCOORD_1 of the square covers twice the area of TEXCOORD_0) with a scaling
+// transform; tolerance 1e-4 (float log2 and the cone's arithmetic: relative errors of a few 1e-7).
 TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
   wp::Scene s;
   wp::Material m;
@@ -808,7 +812,8 @@ TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
       const bool first = p.x >= p.y;
       const glm::dvec2 bary = first ? glm::dvec2(p.x - p.y, p.y) : glm::dvec2(p.x, p.y - p.x);
       const double length =
-          v.ortho ? 2.0 * 0.4 / kHeight : 2.0 * std::tan(0.5 * double(cam.yfov)) / kHeight * t;
+          kConeScale *
+          (v.ortho ? 2.0 * 0.4 / kHeight : 2.0 * std::tan(0.5 * double(cam.yfov)) / kHeight * t);
       const double across = length / std::abs(d.z);
       for (std::uint32_t ref = 0; ref < 2; ++ref) {
         const wp::TextureRef& tr = s.textures[ref];
@@ -839,9 +844,9 @@ TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
 
 // The cone through bounces as the stages carry it, against the ray-cone recurrence in double: at
 // a hit at distance t the width grows by spread x t; leaving it, the spread grows by 2 k |width|
-// (curvature k) and, for a sample that is not a delta lobe, by 2 / sqrt(pi pdf), the full angle of
-// the cone of solid angle 1 / pdf, at most pi: 2 rad for a Lambertian sample at normal incidence
-// (pdf 1/pi), pi for one at cos 0.25.
+// (curvature k) and, for a sample that is not a delta lobe, by an eighth of 2 / sqrt(pi pdf), the
+// full angle of the cone of solid angle 1 / pdf, at most pi: 0.25 rad for a Lambertian sample at
+// normal incidence (pdf 1/pi), pi / 8 for one at cos 0.25.
 // Width and spread pass through the path state's bfloat16 halves between bounces (8 significant
 // bits: 2^-9 relative per rounding, a few roundings per value: 1% relative). The footprint, and so
 // the level, grows at every rough bounce; a mirror (pdf 0) on a flat surface adds no spread.
@@ -862,15 +867,15 @@ TEST(RayCone, GrowsAtEachRoughBounce) {
   for (std::size_t i = 0; i < bounces.size(); ++i) {
     const float4& x = bounces[i];
     width += spread * x.x;
-    spread +=
-        2.0 * x.y * std::abs(width) + (x.z > 0 ? std::min(2.0 / std::sqrt(M_PI * x.z), M_PI) : 0.0);
+    spread += 2.0 * x.y * std::abs(width) +
+              (x.z > 0 ? kConeScale * std::min(2.0 / std::sqrt(M_PI * x.z), M_PI) : 0.0);
     EXPECT_NEAR(got[i].x, width, 0.01 * width) << "bounce " << i;
     EXPECT_NEAR(got[i].y, spread, 0.01 * spread) << "bounce " << i;
     if (i > 0) {
       EXPECT_GT(got[i].x, got[i - 1].x) << "the footprint grows at bounce " << i;
     }
   }
-  EXPECT_NEAR(got[0].y - pixel, 2.0, 0.02) << "a Lambertian sample at normal incidence";
+  EXPECT_NEAR(got[0].y - pixel, 0.25, 0.0025) << "a Lambertian sample at normal incidence";
   EXPECT_EQ(got[2].y, got[1].y) << "a flat mirror adds no spread";
   EXPECT_GT(got[3].y, got[2].y) << "a convex mirror spreads the cone";
 }

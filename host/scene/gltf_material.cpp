@@ -109,21 +109,23 @@ void read_emission(const tinygltf::Material& in, const std::string& where, Mater
   const float strength =
       extension_number(in, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f, where);
   if (strength < 0.0f) throw Error(where + ": negative emissiveStrength");
+  float factor[3];
   double brightest = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const double factor =
+    factor[i] =
         in_range(in.emissiveFactor[static_cast<std::size_t>(i)], 0.0, 1.0, where, "emissiveFactor");
-    brightest = std::max(brightest, factor * double(strength));
+    brightest = std::max(brightest, double(factor[i]) * double(strength));
   }
-  // One scale for the three channels keeps the colour.
-  const double scale = at_most(brightest, kMaxRadiance, where, "emission",
-                               "emissiveFactor x emissive strength; the most radiance wavepath "
-                               "carries",
-                               warnings) /
-                       std::max(brightest, 1e-300);
+  const double limited = at_most(brightest, kMaxRadiance, where, "emission",
+                                 "emissiveFactor x emissive strength; the most radiance wavepath "
+                                 "carries",
+                                 warnings);
+  // Within the limit, the float product as before the limit existed (the same images bit for
+  // bit); beyond it, one scale for the three channels keeps the colour.
   for (int i = 0; i < 3; ++i)
-    out.emission[i] = static_cast<float>(in.emissiveFactor[static_cast<std::size_t>(i)] *
-                                         double(strength) * scale);
+    out.emission[i] = limited < brightest
+                          ? static_cast<float>(double(factor[i]) * strength * (limited / brightest))
+                          : factor[i] * strength;
 }
 
 void read_factors(const tinygltf::Material& in, const std::string& where, Material& out,

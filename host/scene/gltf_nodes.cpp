@@ -137,12 +137,16 @@ PunctualLight make_light(const tinygltf::Model& model, int index, const glm::dma
   if (present(in.color, 3, where, "color"))
     for (int i = 0; i < 3; ++i)
       color[i] = in_range(in.color[static_cast<std::size_t>(i)], 0.0, 1.0, where, "color");
-  const double intensity = in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
-  const double brightest = intensity * std::max({color.x, color.y, color.z});
-  const double scale = at_most(brightest, kMaxRadiance, where, "intensity",
-                               "colour x intensity; the most radiance wavepath carries", warnings) /
-                       std::max(brightest, 1e-300);
-  out.intensity = glm::vec3(glm::dvec3(color) * intensity * scale);
+  const float intensity = in_range(in.intensity, 0.0, HUGE_VAL, where, "intensity");
+  const double brightest = double(intensity) * std::max({color.x, color.y, color.z});
+  const double limited =
+      at_most(brightest, kMaxRadiance, where, "intensity",
+              "colour x intensity; the most radiance wavepath carries", warnings);
+  // Within the limit, the float product as before the limit existed (the same images bit for
+  // bit); beyond it, one scale for the three channels keeps the colour.
+  out.intensity = limited < brightest
+                      ? glm::vec3(glm::dvec3(color) * double(intensity) * (limited / brightest))
+                      : color * intensity;
   out.range = finite(in.range, where, "range");  // tinygltf: 0 when absent (no range)
   require(in.range >= 0.0, where, "range", "> 0", in.range);
   // tinygltf fills glTF's cone defaults (0 and pi/4) for fields a spot light leaves out; the
