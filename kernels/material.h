@@ -218,6 +218,7 @@ static inline TexPoint texture_point(const SceneView* scene, uint4 tv, float u, 
 #if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS || WP_BSDF_EXTENSIONS
   tp.uv = interpolate4(scene->uvs, tv, u, v);
 #else
+  (void)scene, (void)tv, (void)u, (void)v;
   tp.uv = (float4)(0.0f);
 #endif
 #if WP_FEATURE_TEXTURE_LOD

@@ -31,8 +31,9 @@
  * unfiltered one with whole footprints, 4.7e-4 with a quarter, 1.9e-4 with an eighth (pbrt-v4's
  * smallest scale of its ray differentials too), while its relMSE at equal samples stays 1.3-1.6x
  * below the unfiltered render's (docs/performance.md, "Mip-mapped textures: error against time").
- * Emission and alpha are always looked up at level 0 (textures.h), so that the light tables,
- * light samples and shadow rays, which carry no cone, see the same values as the paths. */
+ * Emission and alpha are always looked up at level 0 (material_emission, alpha.h), so that the
+ * light tables, light samples and shadow rays, which carry no cone, see the same values as the
+ * paths. */
 #ifndef WP_RAY_CONE_H
 #define WP_RAY_CONE_H
 

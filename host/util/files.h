@@ -1,6 +1,7 @@
-// Files the renderer keeps for itself: where its caches live, and how a file is written so that
-// no reader ever sees half of it. Used by the BVH cache (host/accel/bvh_cache.h) and the kernel
-// program cache (host/device/program_cache.h).
+// Files: where the renderer's caches live and how it writes a file so that no reader ever sees half
+// of it (the BVH cache, host/accel/bvh_cache.h, and the kernel program cache,
+// host/device/program_cache.h); how the files a user names are read (only regular files) and
+// where outputs can go (checked before rendering).
 #pragma once
 
 #include <cstdint>
