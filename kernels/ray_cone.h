@@ -22,8 +22,10 @@
  *               sample of a lobe that is not delta, an eighth of min(2 / sqrt(pi pdf), pi), the
  *               full angle of the cone whose solid angle is 1 / pdf (the solid angle the sample
  *               stands for): wide for a diffuse bounce (2 rad at normal incidence, so 0.25), narrow
- *               for a glossy one, 0 for a mirror. Straight through a smooth thin-walled
- *               transmitter the cone goes on unchanged.
+ *               for a glossy one, 0 for a mirror. The curvature term is added at every hit
+ *               (shade_surface.h), so also where a path goes straight through a smooth
+ *               thin-walled transmitter, which adds no lobe spread: a flat pane leaves the cone
+ *               as it was.
  * Why an eighth: the samples of a pixel are already spread over it (box filter) and each scattered
  * sample's neighbours over its lobe, so a cone as wide as a whole footprint blurs the image twice
  * over. Measured on DamagedHelmet seen small (tools/mip_study.py's case, 256 x 256, the model ~50
@@ -45,11 +47,12 @@ static inline float2 path_cone(Paths paths, uint slot) {
   return (float2)(high_bf16(path_bounce_word(paths, slot)),
                   high_bf16(path_flags_word(paths, slot)));
 }
-static inline void path_set_cone_width(Paths paths, uint slot, float width) {
-  path_set_bounce_word(paths, slot, with_high_bf16(path_bounce_word(paths, slot), width));
-}
-static inline void path_set_cone_spread(Paths paths, uint slot, float spread) {
-  path_set_flags_word(paths, slot, with_high_bf16(path_flags_word(paths, slot), spread));
+/* Sets it, keeping the words' low halves (both words read before either is written, so that
+ * the reads are path_cone's). */
+static inline void path_set_cone(Paths paths, uint slot, float2 cone) {
+  const uint bounce_word = path_bounce_word(paths, slot), flags_word = path_flags_word(paths, slot);
+  path_set_bounce_word(paths, slot, with_high_bf16(bounce_word, cone.x));
+  path_set_flags_word(paths, slot, with_high_bf16(flags_word, cone.y));
 }
 
 /* The fraction of a sample's footprint the cone covers (above). */

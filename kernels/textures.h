@@ -10,7 +10,7 @@
  *
  * Minification: with WP_FEATURE_TEXTURE_LOD (--mipmaps on, the default, and a texture whose
  * sampler's minFilter is a mip-map mode or unset) a texture is looked up at the level of detail of
- * the path's ray cone (ray_cone.h), trilinearly in the host's mip chain (host/device/mipmap.cpp):
+ * the path's ray cone (ray_cone.h), trilinearly in the host's mip chain (host/scene/mipmap.cpp):
  * a surface far away shows the mean of its texels instead of noise that only many samples average
  * away. Without it the minification filter is ignored: the pixel's average over many jittered
  * samples supersamples the texture (converging to the box-filtered footprint, noisily at low spp).
@@ -77,25 +77,53 @@ static inline float4 texel_bilinear(__global const uint* texels, TextureImage im
   return mix(top, bottom, ay);
 }
 
+/* A texture reference resolved for one lookup: its image, sampler and the point's coordinates,
+ * transformed and wrapped (texel-space position = st x the level's size). */
+typedef struct TexLookup {
+  TextureImage img;
+  float2 st;
+  uint meta_y;     /* wrap S, wrap T, WP_TEX_* flags */
+  uint level_term; /* TextureRef.meta.w */
+  uint set;        /* texture coordinate set */
+} TexLookup;
+
+/* Texture `ref` at the vertex texture coordinates uv01 (xy: TEXCOORD_0, zw: TEXCOORD_1). */
+static inline TexLookup texture_lookup(const SceneView* scene, int ref, float4 uv01) {
+  __global const TextureRef* t = scene->textures + ref;
+  const uint4 meta = t->meta;
+  TexLookup l;
+  l.img = scene->images[meta.x];
+  l.meta_y = meta.y;
+  l.level_term = meta.w;
+  l.set = meta.z;
+  const float2 uv = meta.z == 1u ? uv01.zw : uv01.xy;
+  const float4 ru = t->transform_u, rv = t->transform_v;
+  l.st = (float2)(wrap_reduce(ru.x * uv.x + ru.y * uv.y + ru.z, meta.y & 0xffu),
+                  wrap_reduce(rv.x * uv.x + rv.y * uv.y + rv.z, (meta.y >> 8) & 0xffu));
+  return l;
+}
+
+/* Lookup l at level `img` (the image or one of its mip levels), bilinear, or NEAREST with
+ * `nearest`. */
+static inline float4 texel_filtered(__global const uint* texels, TexLookup l, TextureImage img,
+                                    bool nearest) {
+  const uint wrap_s = l.meta_y & 0xffu, wrap_t = (l.meta_y >> 8) & 0xffu;
+  const bool srgb = (l.meta_y & WP_TEX_SRGB) != 0u;
+  const int w = (int)img.width, h = (int)img.height;
+  /* Texel-space position: texel i covers [i, i + 1), its centre at i + 0.5. */
+  const float x = l.st.x * (float)w, y = l.st.y * (float)h;
+  if (nearest) {
+    const int i = wrap_texel((int)floor(x), w, wrap_s), j = wrap_texel((int)floor(y), h, wrap_t);
+    return texel_fetch(texels, img, i, j, srgb);
+  }
+  return texel_bilinear(texels, img, x, y, wrap_s, wrap_t, srgb);
+}
+
 /* Texture `ref` at the vertex texture coordinates uv01 (xy: TEXCOORD_0, zw: TEXCOORD_1), at full
  * resolution (level 0) with the sampler's magnification filter. */
 static inline float4 texture_sample(const SceneView* scene, int ref, float4 uv01) {
-  __global const TextureRef* t = scene->textures + ref;
-  const uint4 meta = t->meta;
-  const TextureImage img = scene->images[meta.x];
-  const float2 uv = meta.z == 1u ? uv01.zw : uv01.xy;
-  const float4 ru = t->transform_u, rv = t->transform_v;
-  const uint wrap_s = meta.y & 0xffu, wrap_t = (meta.y >> 8) & 0xffu;
-  const bool srgb = (meta.y & WP_TEX_SRGB) != 0u;
-  const int w = (int)img.width, h = (int)img.height;
-  /* Texel-space position: texel i covers [i, i + 1), its centre at i + 0.5. */
-  const float x = wrap_reduce(ru.x * uv.x + ru.y * uv.y + ru.z, wrap_s) * (float)w;
-  const float y = wrap_reduce(rv.x * uv.x + rv.y * uv.y + rv.z, wrap_t) * (float)h;
-  if (meta.y & WP_TEX_NEAREST) {
-    const int i = wrap_texel((int)floor(x), w, wrap_s), j = wrap_texel((int)floor(y), h, wrap_t);
-    return texel_fetch(scene->texels, img, i, j, srgb);
-  }
-  return texel_bilinear(scene->texels, img, x, y, wrap_s, wrap_t, srgb);
+  const TexLookup l = texture_lookup(scene, ref, uv01);
+  return texel_filtered(scene->texels, l, l.img, (l.meta_y & WP_TEX_NEAREST) != 0u);
 }
 
 /* A point's texture coordinates, and with WP_FEATURE_TEXTURE_LOD the log2 of its ray cone's
@@ -109,7 +137,7 @@ typedef struct TexPoint {
 
 #if WP_FEATURE_TEXTURE_LOD
 /* Mip level `level` of img (TextureImage.levels of them, level 0 the image;
- * host/device/mipmap.cpp): each level halves the one before, rounding down, and follows it in the
+ * host/scene/mipmap.cpp): each level halves the one before, rounding down, and follows it in the
  * texel array. */
 static inline TextureImage mip_level(TextureImage img, uint level) {
   for (uint k = 0u; k < level; ++k) {
@@ -125,28 +153,17 @@ static inline TextureImage mip_level(TextureImage img, uint level) {
  * in the two levels around lambda and linear between them (trilinear); where lambda <= 0, or the
  * texture has no mip-maps (meta.w = -INFINITY), texture_sample's full-resolution lookup. */
 static inline float4 texture_sample_lod(const SceneView* scene, int ref, float4 uv01, float2 lod) {
-  __global const TextureRef* t = scene->textures + ref;
-  const uint4 meta = t->meta;
-  const float lambda = (meta.z == 1u ? lod.y : lod.x) + as_float(meta.w);
-  const TextureImage img = scene->images[meta.x];
-  if (!(lambda > 0.0f) || img.levels < 2u) return texture_sample(scene, ref, uv01);
-  const float2 uv = meta.z == 1u ? uv01.zw : uv01.xy;
-  const float4 ru = t->transform_u, rv = t->transform_v;
-  const uint wrap_s = meta.y & 0xffu, wrap_t = (meta.y >> 8) & 0xffu;
-  const bool srgb = (meta.y & WP_TEX_SRGB) != 0u;
-  const float s = wrap_reduce(ru.x * uv.x + ru.y * uv.y + ru.z, wrap_s);
-  const float r = wrap_reduce(rv.x * uv.x + rv.y * uv.y + rv.z, wrap_t);
-  const float last = (float)(img.levels - 1u);
-  const float l = fmin(lambda, last);
-  const float l0 = floor(l);
-  const TextureImage a = mip_level(img, (uint)l0);
-  const float4 ca = texel_bilinear(scene->texels, a, s * (float)a.width, r * (float)a.height,
-                                   wrap_s, wrap_t, srgb);
-  if (l0 >= last) return ca;
-  const TextureImage b = mip_level(a, 1u);
-  const float4 cb = texel_bilinear(scene->texels, b, s * (float)b.width, r * (float)b.height,
-                                   wrap_s, wrap_t, srgb);
-  return mix(ca, cb, l - l0);
+  const TexLookup l = texture_lookup(scene, ref, uv01);
+  const float lambda = (l.set == 1u ? lod.y : lod.x) + as_float(l.level_term);
+  if (!(lambda > 0.0f) || l.img.levels < 2u)
+    return texel_filtered(scene->texels, l, l.img, (l.meta_y & WP_TEX_NEAREST) != 0u);
+  const float last = (float)(l.img.levels - 1u);
+  const float m = fmin(lambda, last);
+  const float m0 = floor(m);
+  const TextureImage a = mip_level(l.img, (uint)m0);
+  const float4 ca = texel_filtered(scene->texels, l, a, false);
+  if (m0 >= last) return ca;
+  return mix(ca, texel_filtered(scene->texels, l, mip_level(a, 1u), false), m - m0);
 }
 #endif
 

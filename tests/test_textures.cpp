@@ -41,10 +41,14 @@ wp::test::KernelHarness& harness() {
   return h;
 }
 
-wp::SceneBuffers upload(const wp::Scene& s, wp::test::KernelHarness& h = harness()) {
+// s packed as renders pack it, with mip chains (SceneExtras::mipmaps) or without.
+wp::SceneBuffers upload(const wp::Scene& s, wp::test::KernelHarness& h = harness(),
+                        bool mipmaps = false, const wp::dev::Camera& camera = {}) {
   const wp::LightTable lights;
   wp::SceneExtras extras;
   extras.lights = &lights;
+  extras.mipmaps = mipmaps;
+  extras.camera = camera;
   const wp::PackedScene p = wp::pack_scene(s, wp::bvh::Bvh{}, extras);
   // The test program is built without WP_SCENE_BUFFER_MAP: everything in buffer 0.
   if (p.buffers.size() != 1) throw std::logic_error("test scene split over several buffers");
@@ -649,17 +653,6 @@ TEST(MipChain, EachLevelIsTheBoxFilterOfLevelZero) {
   std::printf("%zu codes checked, %zu ties rounded the other way\n", checked, ties);
 }
 
-wp::SceneBuffers upload_mipmapped(const wp::Scene& s, const wp::dev::Camera& camera = {}) {
-  const wp::LightTable lights;
-  wp::SceneExtras extras;
-  extras.lights = &lights;
-  extras.mipmaps = true;
-  extras.camera = camera;
-  const wp::PackedScene p = wp::pack_scene(s, wp::bvh::Bvh{}, extras);
-  if (p.buffers.size() != 1) throw std::logic_error("test scene split over several buffers");
-  return wp::upload_scene(harness().runtime().context(), p);
-}
-
 // The texture's own term of its level (device_scene.cpp's lod_term), as the device adds it: in
 // float.
 float lod_term(const wp::Image& img, const wp::TextureRef& t) {
@@ -704,7 +697,7 @@ TEST(TextureSample, LevelsMatchTrilinearReference) {
   auto& h = harness();
   const cl::Buffer rb = h.buffer(refs), ub = h.buffer(uvs), lb = h.buffer(lods);
   const cl::Buffer out = h.buffer<float4>(uvs.size());
-  const wp::SceneBuffers scene = upload_mipmapped(s);
+  const wp::SceneBuffers scene = upload(s, h, true);
   h.run("sample_textures_lod", uvs.size(), scene, rb, ub, lb, cl_uint(uvs.size()), out);
   const std::vector<float4> got = h.read<float4>(out, uvs.size());
 
@@ -833,7 +826,7 @@ TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
     auto& h = harness();
     const cl::Buffer qb = h.buffer(queries), rb = h.buffer(rays);
     const cl::Buffer out = h.buffer<float4>(queries.size());
-    h.run("camera_ray_levels", queries.size(), upload_mipmapped(s, dc), qb, rb, cl_uint(kHeight),
+    h.run("camera_ray_levels", queries.size(), upload(s, h, true, dc), qb, rb, cl_uint(kHeight),
           cl_uint(queries.size()), out);
     const std::vector<float4> got = h.read<float4>(out, queries.size());
     for (std::size_t i = 0; i < got.size(); ++i)

@@ -149,8 +149,8 @@ int packed_levels(const Image& img, const ImageUses& uses, std::size_t i) {
 }
 
 // All images' texels in one array, RGBA8 with R in the lowest byte; with `mipmaps`, each image
-// image_uses chains followed by its chain, filtered as colour when a texture uses it as colour
-// (sRGB), else as data.
+// that image_uses chains is followed by its chain, filtered as colour when a texture uses it as
+// colour (sRGB), else as data.
 void pack_images(const Scene& scene, bool mipmaps, std::vector<dev::TextureImage>& images,
                  std::vector<dev::uint>& texels) {
   const ImageUses uses = image_uses(scene, mipmaps);
@@ -398,8 +398,7 @@ SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mip
   for (std::size_t i = 0; i < scene.images.size(); ++i) {
     const Image& img = scene.images[i];
     for (int k = 0; k < packed_levels(img, uses, i); ++k)
-      c.texels += std::uint64_t(std::max(mip_size(img.width, k), 0)) *
-                  std::uint64_t(std::max(mip_size(img.height, k), 0));
+      c.texels += std::uint64_t(mip_size(img.width, k)) * std::uint64_t(mip_size(img.height, k));
   }
   c.lights = scene.lights.size();
   if (env) {

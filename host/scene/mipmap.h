@@ -27,7 +27,7 @@ namespace wp {
 // 1 + floor(log2(min(width, height))).
 int mip_levels(int width, int height);
 
-// Width and height of `level` of a width x height image.
+// The width (or height) of `level` of an image `size` texels wide (or high), size >= 1.
 int mip_size(int size, int level);
 
 // Levels 1 .. mip_levels - 1 of `image`, one after another, RGBA8 like Image::rgba; `srgb` for

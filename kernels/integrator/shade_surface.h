@@ -62,8 +62,7 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   const float width = cone_width_at(cone, t);
   *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, width,
                        &front);
-  path_set_cone_width(paths, slot, width);
-  path_set_cone_spread(paths, slot, cone_spread_curved(cone.y, s->curvature, width));
+  path_set_cone(paths, slot, (float2)(width, cone_spread_curved(cone.y, s->curvature, width)));
 #else
   *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, 0.0f,
                        &front);
