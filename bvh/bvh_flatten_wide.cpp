@@ -190,9 +190,46 @@ class WideFlattener {
 
 }  // namespace
 
+namespace {
+
+// The blocks and inner nodes flatten_wide makes of `root`'s tree (a leaf split by split_leaf
+// counts as its parts), so that each array is allocated once, at its size: the blocks are most of
+// a large scene's BVH, and a vector that doubles holds both copies while it moves.
+std::pair<std::size_t, std::size_t> count_wide(const TreeNode& root) {
+  std::size_t blocks = 0, nodes = 0;
+  std::vector<const TreeNode*> stack = {&root};
+  while (!stack.empty()) {
+    const TreeNode* n = stack.back();
+    stack.pop_back();
+    if (n->is_leaf) {
+      const unsigned count = static_cast<const TreeLeaf*>(n)->count;
+      if (count > kMaxLeafRefs) {
+        const unsigned parts =
+            std::min<unsigned>(WP_BVH8_WIDTH, (count + kMaxLeafRefs - 1) / kMaxLeafRefs);
+        for (unsigned i = 0; i < parts; ++i) {
+          const unsigned part = count * (i + 1) / parts - count * i / parts;
+          blocks += (part + 3) / 4;
+        }
+        ++nodes;
+      } else {
+        blocks += (count + 3) / 4;
+      }
+      continue;
+    }
+    const auto& inner = *static_cast<const TreeInner*>(n);
+    ++nodes;
+    for (unsigned i = 0; i < inner.child_count; ++i) stack.push_back(inner.children[i]);
+  }
+  return {blocks, nodes};
+}
+
+}  // namespace
+
 void flatten_wide(const TreeNode& root, const Box& scene, const BuildInput& input,
                   const BuildOptions& options, Bvh& out) {
-  out.blocks.reserve(input.triangle_count / 4 + 1);
+  const auto [blocks, nodes] = count_wide(root);
+  out.blocks.reserve(blocks);
+  out.nodes8.reserve(nodes + 1);
   WideFlattener flattener(input, options, scene, out);
   if (root.is_leaf)
     flattener.single_leaf(static_cast<const TreeLeaf&>(root), scene);

@@ -4,6 +4,7 @@
 // float32 cannot carry. Each is one line `wavepath: error: ...` and status 1 (or a render without
 // a NaN), never a hang: every run has `timeout` before it, so that a hang fails (status 124)
 // instead of blocking the suite.
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -162,6 +163,41 @@ TEST_F(EdgeCli, ImageTheDeviceCannotHoldIsRefusedWithBothSizes) {
                "16384 x 16384");
   EXPECT_NE(r.err.find("(CL_DEVICE_MAX_MEM_ALLOC_SIZE)"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
+}
+
+// A mesh placed by many nodes is a copy per node (until instancing): 10^5 nodes placing one mesh of
+// 10^5 triangles are 10^10 triangles, which no machine this runs on holds (their least packed size
+// alone is 200 GB: 16 bytes of vertex references and 4 of light slot a triangle, before the BVH).
+// The scene is refused from its counts, before its geometry is loaded: one line naming the
+// triangles and placements, and the process never grows beyond the parsed file (the loaded
+// triangles' indices alone would be 120 GB). The file is 3.6 MB of zero positions and 3.8 MB of
+// JSON.
+TEST_F(EdgeCli, SceneTooLargeFromItsPlacementsIsRefusedBeforeLoading) {
+  constexpr int kNodes = 100000, kTriangles = 100000;
+  const std::size_t bytes = std::size_t{3} * kTriangles * 3 * sizeof(float);
+  {
+    const std::vector<char> zeros(bytes, 0);
+    std::ofstream(dir_ / "mesh.bin", std::ios::binary).write(zeros.data(), std::streamsize(bytes));
+  }
+  std::ofstream f(dir_ / "forest.gltf");
+  f << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[)";
+  for (int i = 0; i < kNodes; ++i) f << (i ? "," : "") << i;
+  f << R"(]}],"nodes":[)";
+  for (int i = 0; i < kNodes; ++i)
+    f << (i ? "," : "") << R"({"mesh":0,"translation":[)" << i << ",0,0]}";
+  f << R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+    << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << 3 * kTriangles
+    << R"(,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}],)"
+    << R"("bufferViews":[{"buffer":0,"byteLength":)" << bytes << R"(}],)"
+    << R"("buffers":[{"byteLength":)" << bytes << R"(,"uri":"mesh.bin"}]})";
+  f.close();
+  const CliRun r = run("render forest.gltf --width 64 --height 48 --spp 1 -o out.exr");
+  expect_error(r, "scene too large: its 10000000000 triangles (100000 mesh placements, ",
+               "placements");
+  EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
+  rusage usage{};
+  ASSERT_EQ(::getrusage(RUSAGE_CHILDREN, &usage), 0);
+  EXPECT_LT(usage.ru_maxrss, 1024L * 1024L) << "peak resident size of a child, KiB";
 }
 
 // Quads, one primitive each: (corner, edge u, edge v, material). Written as `name`.gltf with its

@@ -120,7 +120,14 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   // be the --checkpoint file, which the render replaces).
   std::optional<wp::Film> resume;
   if (!cli.resume.empty()) resume = wp::Film::read(cli.resume);
-  const wp::Scene scene = wp::load_gltf(cli.scene, wp::LoadOptions{cli.variant});
+  // Ranks on one machine spread over its devices, unless --device names one. The device is known
+  // before the scene loads, so that a scene it cannot hold is refused from its counts.
+  const wp::DeviceEntry device = wp::select_device(cli.device, ranks.local_rank());
+  wp::LoadOptions load{cli.variant};
+  load.check_counts = [&](const wp::LoadCounts& counts) {
+    wp::check_scene_counts(counts, device, mine);
+  };
+  const wp::Scene scene = wp::load_gltf(cli.scene, load);
   // A camera the scene cannot give (an index past its cameras, a lens on an orthographic one, a
   // focus behind it) is known now, not only once the kernels are built and the BVH is made.
   (void)wp::choose_camera(scene, mine.camera, mine.view, float(mine.width) / float(mine.height));
@@ -129,8 +136,7 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   if (!cli.quiet && ranks.root())
     for (const auto& w : scene.warnings) std::fprintf(stderr, "wavepath: warning: %s\n", w.c_str());
 
-  // Ranks on one machine spread over its devices, unless --device names one.
-  wp::ClRuntime runtime(wp::select_device(cli.device, ranks.local_rank()));
+  wp::ClRuntime runtime(device);
   wp::RenderOptions options;
   options.bvh.spatial_splits = cli.spatial_splits;
   options.bvh_cache = !cli.no_bvh_cache;

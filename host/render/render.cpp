@@ -118,14 +118,16 @@ std::uint64_t available_memory() {
   return std::uint64_t(kib) * 1024;
 }
 
+// "13.94 GB", as the memory errors write sizes.
+std::string gb(std::uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f GB", double(bytes) / 1e9);
+  return buf;
+}
+
 }  // namespace
 
 void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uint64_t available) {
-  const auto gb = [](std::uint64_t b) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.2f GB", double(b) / 1e9);
-    return std::string(buf);
-  };
   if (device.gpu) {
     if (device.global_memory && bytes > device.global_memory)
       throw Error("scene too large for the device: it packs into " + gb(bytes) + ", " +
@@ -135,6 +137,38 @@ void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uin
   if (available && bytes > available)
     throw Error("scene too large for this machine's memory: it packs into " + gb(bytes) + ", " +
                 gb(available) + " are available");
+}
+
+void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
+                        const RenderSettings& settings) {
+  const std::string what = "scene too large: its " + std::to_string(counts.triangles) +
+                           " triangles (" + std::to_string(counts.placements) +
+                           " mesh placements, each a copy of its mesh) ";
+  SceneCounts least;
+  least.triangles = counts.triangles;
+  std::uint64_t packed = 0;
+  try {
+    packed = scene_layout(least, min_bvh_bytes(least.triangles, bvh_width(device, settings)),
+                          scene_buffer_limit(device, settings))
+                 .total_bytes();
+  } catch (const Error& e) {  // an array larger than a buffer, or more than the buffers
+    throw Error(what + "cannot be packed: " + e.what());
+  }
+  const std::uint64_t loading =
+      counts.triangles * (3 * sizeof(std::uint32_t) + sizeof(std::uint32_t));
+  const std::uint64_t available = available_memory();
+  if (device.gpu) {
+    if (device.global_memory && packed > device.global_memory)
+      throw Error(what + "pack into at least " + gb(packed) + ", " + device.name + " has " +
+                  gb(device.global_memory));
+    if (available && loading > available)
+      throw Error(what + "need at least " + gb(loading) + " of host memory to load, " +
+                  gb(available) + " are available");
+    return;
+  }
+  if (available && packed + loading > available)
+    throw Error(what + "need at least " + gb(packed + loading) + " of memory (" + gb(packed) +
+                " packed, " + gb(loading) + " to load them), " + gb(available) + " are available");
 }
 
 void check_state_memory(const StateMemory& memory, const RenderSettings& settings,
@@ -173,8 +207,7 @@ bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings&
                    bool* cached) {
   std::vector<std::uint32_t> flags;
   const SceneCounts counts =
-      scene_counts(scene, settings.environment.get(),
-                   render_features(scene, settings).texture_lod);
+      scene_counts(scene, settings.environment.get(), render_features(scene, settings).texture_lod);
   const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
   check_scene_memory(
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)

@@ -11,6 +11,7 @@
 #include "bvh/bvh.h"
 #include "host/device/cl_runtime.h"
 #include "host/film/image_io.h"
+#include "host/scene/gltf_loader.h"
 #include "host/scene/scene.h"
 #include "host/render/wavefront.h"
 
@@ -130,6 +131,16 @@ std::string render_key(const Scene& scene, const RenderSettings& settings, int b
 // scene is host memory there, used in place; 0: unknown, not checked), where the system would
 // otherwise kill the process for memory. render() checks with /proc/meminfo's MemAvailable.
 void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uint64_t available);
+
+// For LoadOptions::check_counts: fails (wp::Error naming the triangles, the placements and both
+// sizes) when a scene of these counts cannot be held, before the loader allocates for it: the
+// least packed scene its triangles need (their vertex references and light slots, the least BVH
+// of `device`'s layout; check_scene_memory, and a single array larger than a device buffer) plus,
+// in host memory, the loader's 16 bytes a triangle (indices, material). A mesh placed by many
+// nodes counts once per node (no instancing yet), so such a scene is refused from its node count
+// alone instead of growing until the system kills the process.
+void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
+                        const RenderSettings& settings);
 
 // Fails (wp::Error naming the image size, the bytes needed and the device's limit) when the
 // buffers of `memory` cannot be allocated on `device`: one larger than CL_DEVICE_MAX_MEM_ALLOC_SIZE

@@ -127,6 +127,24 @@ std::size_t span_bytes(std::size_t count, std::size_t stride, std::size_t elemen
 
 }  // namespace
 
+std::size_t readable_count(const tinygltf::Model& model, int accessor) {
+  if (accessor < 0 || static_cast<std::size_t>(accessor) >= model.accessors.size()) return 0;
+  const tinygltf::Accessor& a = model.accessors[static_cast<std::size_t>(accessor)];
+  const std::size_t element = static_cast<std::size_t>(component_size(a.componentType)) *
+                              static_cast<std::size_t>(component_count(a.type));
+  if (element == 0) return 0;
+  if (a.bufferView < 0 || static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size())
+    return 0;
+  const std::size_t stride = model.bufferViews[static_cast<std::size_t>(a.bufferView)].byteStride;
+  try {
+    view_range(model, a.bufferView, a.byteOffset,
+               span_bytes(a.count, std::max(stride, element), element, ""), "");
+  } catch (const Error&) {
+    return 0;
+  }
+  return a.count;
+}
+
 AccessorReader::AccessorReader(const tinygltf::Model& model, int accessor, const AccessorSpec& spec)
     : index_(accessor), what_(spec.what) {
   const std::string where = "accessor " + std::to_string(accessor) + " (" + spec.what + ")";

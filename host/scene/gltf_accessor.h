@@ -71,4 +71,10 @@ class AccessorReader {
   std::vector<unsigned char> dense_;  // sparse accessors: base data with the sparse values applied
 };
 
+// The element count of accessor `accessor` when the bytes it spans lie in its bufferView and
+// buffer, else 0 (also without a bufferView: such an accessor is zeros, whatever its count).
+// Checks no type and reads nothing: for counting a scene before it is loaded, where a count that
+// no bytes of the file hold must not size anything.
+std::size_t readable_count(const tinygltf::Model& model, int accessor);
+
 }  // namespace wp::gltf

@@ -22,6 +22,7 @@
 #include "host/util/error.h"
 #include "host/util/files.h"
 #include "host/util/fnv1a.h"
+#include "host/scene/gltf_accessor.h"
 #include "host/scene/gltf_extensions.h"
 #include "host/scene/gltf_material.h"
 #include "host/scene/gltf_nodes.h"
@@ -270,9 +271,17 @@ class SceneBuilder {
   SceneBuilder(const tinygltf::Model& model, Scene& scene, int variant)
       : model_(model), scene_(scene), variant_(variant) {}
 
-  void build(int scene_index);
+  // What build() will load: the placements and their triangles (gltf_loader.h).
+  LoadCounts count(int scene_index) const;
+  // Loads the scene; `counts` (from count()) size the triangle arrays once.
+  void build(int scene_index, const LoadCounts& counts);
 
  private:
+  // Visits the nodes of scene `scene_index` depth-first, children in order, with each node's
+  // world transform: visit(node, world). Throws for missing nodes, cycles and nodes reached twice.
+  template <class Visit>
+  void walk(int scene_index, Visit&& visit) const;
+  void count_mesh(int mesh, LoadCounts& counts) const;
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
   void count_placement(const tinygltf::Node& node);
@@ -293,10 +302,9 @@ class SceneBuilder {
 
 // Depth-first, children in order, with an explicit stack: node order defines camera order, and
 // a deep hierarchy must not overflow the call stack.
-void SceneBuilder::build(int scene_index) {
+template <class Visit>
+void SceneBuilder::walk(int scene_index, Visit&& visit) const {
   const tinygltf::Scene& scene = model_.scenes[static_cast<std::size_t>(scene_index)];
-  for (const TextureRef& t : scene_.textures) file_needs_.uv1 |= t.texcoord == 1;
-  for (const Material& m : scene_.materials) file_needs_.tangents |= needs_tangents(m);
   constexpr int kUnvisited = -2, kRoot = -1;
   std::vector<int> parent(model_.nodes.size(), kUnvisited);
   struct Item {
@@ -322,6 +330,44 @@ void SceneBuilder::build(int scene_index) {
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
       stack.push_back({*it, item.node, world});
   }
+}
+
+// One placement of mesh `mesh` in `counts`. A mesh, primitive or accessor that does not exist or
+// cannot be read counts nothing: build() reports it.
+void SceneBuilder::count_mesh(int mesh, LoadCounts& counts) const {
+  ++counts.placements;
+  if (mesh < 0 || static_cast<std::size_t>(mesh) >= model_.meshes.size()) return;
+  for (const tinygltf::Primitive& p : model_.meshes[static_cast<std::size_t>(mesh)].primitives) {
+    const auto position = p.attributes.find("POSITION");
+    if (!gltf::is_triangle_mode(p.mode) || position == p.attributes.end()) continue;
+    const std::uint64_t n =
+        gltf::readable_count(model_, p.indices >= 0 ? p.indices : position->second);
+    if (p.mode < 0 || p.mode == TINYGLTF_MODE_TRIANGLES) {
+      counts.triangles += n / 3;
+      counts.max_triangles += n / 3;
+    } else if (n >= 3) {
+      counts.max_triangles += n - 2;
+    }
+  }
+}
+
+LoadCounts SceneBuilder::count(int scene_index) const {
+  LoadCounts counts;
+  walk(scene_index, [&](int node, const glm::dmat4&) {
+    const int mesh = model_.nodes[static_cast<std::size_t>(node)].mesh;
+    if (mesh >= 0) count_mesh(mesh, counts);
+  });
+  return counts;
+}
+
+void SceneBuilder::build(int scene_index, const LoadCounts& counts) {
+  for (const TextureRef& t : scene_.textures) file_needs_.uv1 |= t.texcoord == 1;
+  for (const Material& m : scene_.materials) file_needs_.tangents |= needs_tangents(m);
+  // At most max_triangles, each counted from bytes in the file; vertices are counted per
+  // primitive as it is loaded (gltf_primitive.cpp).
+  scene_.indices.reserve(3 * counts.max_triangles);
+  scene_.triangle_material.reserve(counts.max_triangles);
+  walk(scene_index, [this](int node, const glm::dmat4& world) { visit(node, world); });
 }
 
 std::string SceneBuilder::revisit_message(const std::vector<int>& parent, int node, int from) {
@@ -530,7 +576,10 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
       scene.materials.push_back(
           gltf::convert_material(model, static_cast<int>(i), textures, &clamped));
     for (const std::string& w : clamped) scene.warnings.push_back(path + ": " + w);
-    SceneBuilder(model, scene, variant).build(scene_index);
+    SceneBuilder builder(model, scene, variant);
+    const LoadCounts counts = builder.count(scene_index);
+    if (options.check_counts) options.check_counts(counts);
+    builder.build(scene_index, counts);
     // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
     if (scene.triangle_count() == 0)
       scene.warnings.push_back(path + ": scene " + std::to_string(scene_index) +

@@ -1,18 +1,41 @@
 // glTF 2.0 (.gltf and .glb) into the host scene (scene.h), via tinygltf.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
+#include <utility>
 
 #include "host/scene/scene.h"
 
 namespace wp {
 
+// What the default scene of a file will load, counted from its node tree and its accessors'
+// counts before any vertex is read or any array allocated. Every mesh node places a copy of its
+// mesh (EXT_mesh_gpu_instancing, ignored, places one), so a mesh of T triangles placed by N nodes
+// counts N x T.
+struct LoadCounts {
+  std::uint64_t placements = 0;  // nodes of the default scene with a mesh
+  // Triangles: at least `triangles` (triangle lists: indices / 3, or vertices / 3 without indices;
+  // strips and fans count 0, as they may be all degenerate) and at most `max_triangles` (strips
+  // and fans: n - 2). Only accessors whose data lies in the file count (an accessor without a
+  // bufferView, all zeros, counts none: gltf_accessor.h, readable_count).
+  std::uint64_t triangles = 0, max_triangles = 0;
+};
+
 // How to load a file, beyond what it says itself.
 struct LoadOptions {
+  LoadOptions() = default;
+  explicit LoadOptions(std::string variant_name) : variant(std::move(variant_name)) {}
+
   // KHR_materials_variants: the name of the variant whose materials the primitives get (each
   // primitive's mapping for it, or its own material where it has none); empty: the file's own
   // materials. A name the file does not define is an error listing the names it does.
   std::string variant;
+  // Called with the file's counts once it is parsed and before its geometry is loaded; throwing
+  // wp::Error refuses the scene before the loader allocates for it (the renderer checks them
+  // against the device's memory: render.h, check_scene_counts).
+  std::function<void(const LoadCounts&)> check_counts;
 };
 
 // Loads the default scene (or scene 0) of a glTF file: the node hierarchy with full transforms,

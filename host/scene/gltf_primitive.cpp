@@ -76,15 +76,6 @@ std::vector<std::uint32_t> triangle_corners(const tinygltf::Model& model,
   return tris;
 }
 
-// The vertices some triangle uses (compacted, in first-use order), in world space. `normal` is
-// zero where the file has none or the one it has is unusable.
-struct Vertices {
-  std::vector<glm::vec3> position, normal;
-  std::vector<glm::vec2> uv, uv1;         // uv1: when needs.uv1
-  std::vector<glm::vec4> color, tangent;  // tangent: when needs.tangents
-  bool has_tangents = false;              // the primitive supplies TANGENT
-};
-
 // n transforms like the inverse transpose of the 3x3 part, up to a positive factor; the cofactor
 // matrix gives that without dividing by a determinant that may be zero.
 glm::dmat3 normal_matrix(const glm::dmat4& world) {
@@ -118,102 +109,150 @@ glm::vec4 world_tangent(const glm::dmat3& m, bool mirror, const float* f) {
   return len > 0.0 && std::isfinite(len) ? glm::vec4(glm::vec3(t / len), w) : glm::vec4(0, 0, 0, w);
 }
 
-// The optional attributes beyond POSITION, NORMAL, TEXCOORD_0 and COLOR_0.
-void read_extra(const tinygltf::Model& model, const tinygltf::Primitive& p, std::size_t count,
-                const std::vector<std::uint32_t>& used, const glm::dmat4& world,
-                const VertexNeeds& needs, Vertices& v) {
-  if (needs.uv1) {
-    v.uv1.assign(used.size(), glm::vec2(0.0f));
-    if (const auto uv1 = open_attribute(model, p, "TEXCOORD_1", kTexcoord1, count))
-      for (std::size_t k = 0; k < used.size(); ++k) uv1->read(used[k], glm::value_ptr(v.uv1[k]));
+// A primitive's vertices in world space, read from its accessors when appended: the loader keeps
+// no copy of a primitive's vertices beside the scene's arrays (a 40-million-triangle mesh would
+// need gigabytes more).
+class VertexSource {
+ public:
+  VertexSource(const tinygltf::Model& model, const tinygltf::Primitive& p,
+               const AccessorReader& pos, const glm::dmat4& world, const VertexNeeds& needs)
+      : pos_(pos),
+        normal_(open_attribute(model, p, "NORMAL", kNormal, pos.count())),
+        uv_(open_attribute(model, p, "TEXCOORD_0", kTexcoord, pos.count())),
+        color_(open_attribute(model, p, "COLOR_0", kColor, pos.count())),
+        world_(world),
+        normal_matrix_(normal_matrix(world)),
+        mirror_(glm::determinant(glm::dmat3(world)) < 0.0),
+        uv1_needed_(needs.uv1),
+        tangents_needed_(needs.tangents) {
+    if (uv1_needed_) uv1_ = open_attribute(model, p, "TEXCOORD_1", kTexcoord1, pos.count());
+    if (tangents_needed_) tangent_ = open_attribute(model, p, "TANGENT", kTangent, pos.count());
   }
-  if (needs.tangents) {
-    v.tangent.assign(used.size(), glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
-    const auto tangent = open_attribute(model, p, "TANGENT", kTangent, count);
-    v.has_tangents = tangent.has_value();
-    const glm::dmat3 m(world);
-    const bool mirror = glm::determinant(m) < 0.0;
+
+  bool mirror() const { return mirror_; }
+  bool has_tangents() const { return tangent_.has_value(); }
+
+  // Vertex i's position in world space; throws where it is not finite.
+  glm::vec3 position(std::uint32_t i) const {
     float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-    for (std::size_t k = 0; tangent && k < used.size(); ++k) {
-      tangent->read(used[k], f);
-      v.tangent[k] = world_tangent(m, mirror, f);
-    }
+    pos_.read(i, f);
+    const glm::vec3 p(world_ * glm::dvec4(f[0], f[1], f[2], 1.0));
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw Error("POSITION " + std::to_string(i) + " is not finite (in world space)");
+    return p;
   }
-}
 
-Vertices read_vertices(const tinygltf::Model& model, const tinygltf::Primitive& p,
-                       const AccessorReader& pos, const std::vector<std::uint32_t>& used,
-                       const glm::dmat4& world, const VertexNeeds& needs) {
-  const auto normal = open_attribute(model, p, "NORMAL", kNormal, pos.count());
-  const auto uv = open_attribute(model, p, "TEXCOORD_0", kTexcoord, pos.count());
-  const auto color = open_attribute(model, p, "COLOR_0", kColor, pos.count());
-  const glm::dmat3 nm = normal_matrix(world);
-
-  Vertices v;
-  v.position.resize(used.size());
-  v.normal.assign(used.size(), glm::vec3(0.0f));
-  v.uv.assign(used.size(), glm::vec2(0.0f));
-  v.color.assign(used.size(), glm::vec4(1.0f));
-  float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-  for (std::size_t k = 0; k < used.size(); ++k) {
-    pos.read(used[k], f);
-    const glm::dvec4 w = world * glm::dvec4(f[0], f[1], f[2], 1.0);
-    v.position[k] = glm::vec3(w);
-    if (!std::isfinite(v.position[k].x) || !std::isfinite(v.position[k].y) ||
-        !std::isfinite(v.position[k].z))
-      throw Error("POSITION " + std::to_string(used[k]) + " is not finite (in world space)");
-    if (normal) {
-      normal->read(used[k], f);
-      const glm::dvec3 n = nm * glm::dvec3(f[0], f[1], f[2]);
-      const double len = glm::length(n);  // in double: the cofactor scales by scale squared
-      if (len > 0.0 && std::isfinite(len)) v.normal[k] = glm::vec3(n / len);
-    }
-    if (uv) uv->read(used[k], glm::value_ptr(v.uv[k]));
-    if (color) {
-      f[3] = 1.0f;  // vec3 colours are opaque
-      color->read(used[k], f);
-      v.color[k] = glm::vec4(f[0], f[1], f[2], f[3]);
-    }
+  // Vertex i's unit normal in world space; zero where the file has none or an unusable one.
+  glm::vec3 normal(std::uint32_t i) const {
+    if (!normal_) return glm::vec3(0.0f);
+    float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    normal_->read(i, f);
+    const glm::dvec3 n = normal_matrix_ * glm::dvec3(f[0], f[1], f[2]);
+    const double len = glm::length(n);  // in double: the cofactor scales by scale squared
+    return len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0.0f);
   }
-  read_extra(model, p, pos.count(), used, world, needs, v);
-  return v;
+
+  // Appends vertex i with position p and normal n to every per-vertex array the scene keeps.
+  std::uint32_t push(Scene& s, std::uint32_t i, const glm::vec3& p, const glm::vec3& n) const {
+    s.positions.push_back(p);
+    s.normals.push_back(n);
+    glm::vec2 uv(0.0f);
+    if (uv_) uv_->read(i, glm::value_ptr(uv));
+    s.uv0.push_back(uv);
+    float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // vec3 colours are opaque
+    if (color_) color_->read(i, f);
+    s.color0.push_back(color_ ? glm::vec4(f[0], f[1], f[2], f[3]) : glm::vec4(1.0f));
+    if (uv1_needed_) {
+      glm::vec2 uv1(0.0f);
+      if (uv1_) uv1_->read(i, glm::value_ptr(uv1));
+      s.uv1.push_back(uv1);
+    }
+    if (tangents_needed_) {
+      float t[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+      if (tangent_) tangent_->read(i, t);
+      s.tangents.push_back(tangent_ ? world_tangent(glm::dmat3(world_), mirror_, t)
+                                    : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+    }
+    return static_cast<std::uint32_t>(s.positions.size() - 1);
+  }
+
+ private:
+  const AccessorReader& pos_;
+  std::optional<AccessorReader> normal_, uv_, color_, uv1_, tangent_;
+  glm::dmat4 world_;
+  glm::dmat3 normal_matrix_;
+  bool mirror_;
+  bool uv1_needed_, tangents_needed_;
+};
+
+// Makes room for `extra` more vertices in every per-vertex array the scene keeps. A vector that
+// must grow gets what is asked plus a quarter of what it holds, not twice its size: the arrays of
+// a large scene are most of the loader's memory, and the reallocation holds both copies at once.
+void reserve_vertices(Scene& s, std::size_t extra) {
+  const std::size_t need = s.positions.size() + extra;
+  if (need <= s.positions.capacity()) return;
+  const std::size_t capacity = std::max(need, s.positions.size() + s.positions.size() / 4);
+  s.positions.reserve(capacity);
+  s.normals.reserve(capacity);
+  s.uv0.reserve(capacity);
+  s.color0.reserve(capacity);
+  if (!s.uv1.empty() || s.uv1.capacity()) s.uv1.reserve(capacity);
+  if (!s.tangents.empty() || s.tangents.capacity()) s.tangents.reserve(capacity);
 }
 
-// Appends compacted vertex k of `v` with normal `n`.
-std::uint32_t push_vertex(Scene& s, const Vertices& v, std::uint32_t k, const glm::vec3& n) {
-  s.positions.push_back(v.position[k]);
-  s.normals.push_back(n);
-  s.uv0.push_back(v.uv[k]);
-  s.color0.push_back(v.color[k]);
-  if (!v.uv1.empty()) s.uv1.push_back(v.uv1[k]);
-  if (!v.tangent.empty()) s.tangents.push_back(v.tangent[k]);
-  return static_cast<std::uint32_t>(s.positions.size() - 1);
-}
+// What a triangle's three corners get: their shared vertices where all three have normals,
+// unshared ones carrying the face normal otherwise.
+enum : std::uint8_t { kNormalUnknown = 0, kNormalUsable = 1, kNormalMissing = 2 };
 
-// Appends triangles over compacted vertex ids `tris`: shared vertices where all three corners
-// have normals, unshared ones with the face normal otherwise.
-void emit(const Vertices& v, const std::vector<std::uint32_t>& tris, bool flip,
-          std::uint32_t material, Scene& s) {
-  if (s.positions.size() + v.position.size() + tris.size() >= kUnused)
-    throw Error("more vertices than 32-bit indices can address");
-  std::vector<std::uint32_t> scene_index(v.position.size(), kUnused);
-  const auto shared = [&](std::uint32_t k) {
-    if (scene_index[k] == kUnused) scene_index[k] = push_vertex(s, v, k, v.normal[k]);
-    return scene_index[k];
+// Appends triangles over the primitive's vertex indices `tris`: shared vertices where all three
+// corners have normals, unshared ones with the face normal otherwise, in the order of the
+// triangles (first use). Counts the vertices first, so that the arrays grow once, by that much.
+void emit(const VertexSource& v, std::size_t vertex_count, const std::vector<std::uint32_t>& tris,
+          std::uint32_t material, Scene& s, const VertexNeeds& needs) {
+  const bool flip = v.mirror();
+  std::vector<std::uint8_t> normal_state(vertex_count, kNormalUnknown);
+  const auto usable = [&](std::uint32_t i) {
+    if (normal_state[i] == kNormalUnknown)
+      normal_state[i] = v.normal(i) != glm::vec3(0.0f) ? kNormalUsable : kNormalMissing;
+    return normal_state[i] == kNormalUsable;
   };
-  const glm::vec3 zero(0.0f);
+  const auto corners = [&](std::size_t t, std::uint32_t* k) {
+    k[0] = tris[t], k[1] = tris[t + (flip ? 2 : 1)], k[2] = tris[t + (flip ? 1 : 2)];
+    return usable(k[0]) && usable(k[1]) && usable(k[2]);
+  };
+  std::vector<std::uint32_t> scene_index(vertex_count, kUnused);
+  std::size_t added = 0;  // first pass: how many vertices the triangles add
   for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
-    const std::uint32_t k[3] = {tris[t], tris[t + (flip ? 2 : 1)], tris[t + (flip ? 1 : 2)]};
-    if (v.normal[k[0]] != zero && v.normal[k[1]] != zero && v.normal[k[2]] != zero) {
+    std::uint32_t k[3];
+    if (!corners(t, k)) {
+      added += 3;
+      continue;
+    }
+    for (const std::uint32_t c : k)
+      if (scene_index[c] == kUnused) scene_index[c] = 0, ++added;
+  }
+  if (s.positions.size() + added >= kUnused)
+    throw Error("more vertices than 32-bit indices can address");
+  if (needs.uv1 && s.uv1.empty()) s.uv1.reserve(s.positions.capacity());
+  if (needs.tangents && s.tangents.empty()) s.tangents.reserve(s.positions.capacity());
+  reserve_vertices(s, added);
+  std::fill(scene_index.begin(), scene_index.end(), kUnused);
+  const auto shared = [&](std::uint32_t c) {
+    if (scene_index[c] == kUnused) scene_index[c] = v.push(s, c, v.position(c), v.normal(c));
+    return scene_index[c];
+  };
+  for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
+    std::uint32_t k[3];
+    if (corners(t, k)) {
       for (const std::uint32_t c : k) s.indices.push_back(shared(c));
     } else {
-      const glm::dvec3 p0(v.position[k[0]]);  // double: tiny triangles must not underflow
-      const glm::dvec3 face =
-          glm::cross(glm::dvec3(v.position[k[1]]) - p0, glm::dvec3(v.position[k[2]]) - p0);
+      const glm::vec3 p[3] = {v.position(k[0]), v.position(k[1]), v.position(k[2])};
+      const glm::dvec3 p0(p[0]);  // double: tiny triangles must not underflow
+      const glm::dvec3 face = glm::cross(glm::dvec3(p[1]) - p0, glm::dvec3(p[2]) - p0);
       const double len = glm::length(face);
       // A zero-area triangle has no face normal; any unit vector keeps normals unit.
       const glm::vec3 n = len > 0.0 ? glm::vec3(face / len) : glm::vec3(0.0f, 0.0f, 1.0f);
-      for (const std::uint32_t c : k) s.indices.push_back(push_vertex(s, v, c, n));
+      for (int j = 0; j < 3; ++j) s.indices.push_back(v.push(s, k[j], p[j], n));
     }
     s.triangle_material.push_back(material);
   }
@@ -263,6 +302,7 @@ double corner_angle(const Scene& s, const std::uint32_t* c, int k) {
 std::uint32_t duplicate_vertex(Scene& s, std::uint32_t i) {
   if (s.positions.size() + 1 >= kUnused)
     throw Error("more vertices than 32-bit indices can address");
+  reserve_vertices(s, 1);
   s.positions.push_back(s.positions[i]);
   s.normals.push_back(s.normals[i]);
   s.uv0.push_back(s.uv0[i]);
@@ -358,23 +398,13 @@ std::size_t append_primitive(const tinygltf::Model& model, const tinygltf::Primi
   const AccessorReader pos(model, attribute(primitive, "POSITION"), kPosition);
   if (pos.count() >= kUnused) throw Error("more vertices than 32-bit indices can address");
   std::size_t leftover = 0;
-  std::vector<std::uint32_t> tris = triangle_corners(model, primitive, pos.count(), &leftover);
-
-  // Compact to the vertices in use: accessors may be shared by primitives that each use a part.
-  std::vector<std::uint32_t> compact(pos.count(), kUnused);
-  std::vector<std::uint32_t> used;
-  for (std::uint32_t& corner : tris) {
-    if (compact[corner] == kUnused) {
-      compact[corner] = static_cast<std::uint32_t>(used.size());
-      used.push_back(corner);
-    }
-    corner = compact[corner];
-  }
-  const Vertices v = read_vertices(model, primitive, pos, used, world, needs);
-  const bool flip = glm::determinant(glm::dmat3(world)) < 0.0;
+  const std::vector<std::uint32_t> tris =
+      triangle_corners(model, primitive, pos.count(), &leftover);
+  const VertexSource v(model, primitive, pos, world, needs);
   const std::size_t first_triangle = scene.triangle_count();
-  emit(v, tris, flip, material, scene);
-  if (needs.tangents && !v.has_tangents) generate_tangents(scene, first_triangle, needs.tangent_uv);
+  emit(v, pos.count(), tris, material, scene, needs);
+  if (needs.tangents && !v.has_tangents())
+    generate_tangents(scene, first_triangle, needs.tangent_uv);
   return leftover;
 }
 

@@ -246,7 +246,7 @@ TEST(GltfAssets, MaterialsVariantsShoe) {
   std::set<std::uint64_t> digests = {plain.digest};
   for (std::size_t v = 0; v < plain.variants.size(); ++v) {
     SCOPED_TRACE(plain.variants[v]);
-    const wp::Scene s = wp::load_gltf(path, {plain.variants[v]});
+    const wp::Scene s = wp::load_gltf(path, wp::LoadOptions{plain.variants[v]});
     check_invariants(s);
     EXPECT_EQ(s.triangle_count(), plain.triangle_count());
     for (const std::uint32_t m : s.triangle_material) EXPECT_EQ(m, std::uint32_t(v));
@@ -311,7 +311,8 @@ TEST(GltfAssets, MaterialExtensionModels) {
     EXPECT_EQ(s.variants, (std::vector<std::string>{"Mango Velvet", "Peacock Velvet"}));
     EXPECT_TRUE(near(s.materials[0].sheen_color, {1.0f, 0.329f, 0.1f}));
     EXPECT_FLOAT_EQ(s.materials[0].sheen_roughness, 0.8f);
-    EXPECT_NE(wp::load_gltf(path, {"Peacock Velvet"}).triangle_material, s.triangle_material);
+    EXPECT_NE(wp::load_gltf(path, wp::LoadOptions{"Peacock Velvet"}).triangle_material,
+              s.triangle_material);
   }
   {
     WP_REQUIRE_MODEL(path, "ClearCoatTest/ClearCoatTest.glb");

@@ -68,6 +68,56 @@ TEST(GltfLoader, Summary) {
   EXPECT_EQ(s.materials.size(), 1u);  // glTF's default material
 }
 
+// LoadOptions::check_counts sees the default scene's counts before any geometry is loaded: each
+// placement of a mesh counts its triangles again; triangle lists count indices / 3 (a leftover
+// index none), strips and fans at most n - 2 and at least 0; an accessor whose count no buffer
+// holds counts nothing (the load then reports it). Throwing from the callback refuses the file
+// with that reason, naming it.
+TEST(GltfLoader, CountsBeforeLoading) {
+  Gltf g;
+  const int pos = g.vec3s({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 0, 0}});
+  const int seven = g.indices(std::vector<std::uint16_t>{0, 1, 2, 1, 3, 2, 4});
+  g.mesh({prim({{"POSITION", pos}}, seven)});  // mesh 0: 2 triangles and a leftover index
+  g.mesh({prim({{"POSITION", pos}}, -1, 5)});  // mesh 1: a strip of 5 vertices
+  const int child = g.node(R"("mesh":1)");
+  g.node(R"("mesh":0)", true);
+  g.node(R"("mesh":0,"translation":[5,0,0])", true);
+  g.node(R"("mesh":1,"translation":[0,5,0],"children":[)" + std::to_string(child) + "]", true);
+  g.node(R"("translation":[0,0,5])", true);  // no mesh
+  std::vector<wp::LoadCounts> seen;
+  wp::LoadOptions options;
+  options.check_counts = [&](const wp::LoadCounts& c) { seen.push_back(c); };
+  const wp::Scene s = wp::load_gltf(g.write("counts.gltf"), options);
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].placements, 4u);
+  EXPECT_EQ(seen[0].triangles, 4u);           // 2 x 2 from the lists
+  EXPECT_EQ(seen[0].max_triangles, 4u + 6u);  // and up to 2 x (5 - 2) from the strips
+  EXPECT_EQ(s.triangle_count(), 10u);         // this strip has no degenerate triangle
+  EXPECT_GE(s.triangle_count(), seen[0].triangles);
+  EXPECT_LE(s.triangle_count(), seen[0].max_triangles);
+
+  Gltf lie = g;  // an accessor claiming 3 million vertices over 60 bytes counts nothing
+  lie.accessors[static_cast<std::size_t>(pos)] =
+      R"({"bufferView":0,"componentType":5126,"count":3000000,"type":"VEC3"})";
+  lie.meshes[1] = "{\"primitives\":[" + prim({{"POSITION", pos}}) + "]}";  // a list now
+  seen.clear();
+  const std::string lie_path = lie.write("counts_lie.gltf");
+  EXPECT_THROW(wp::load_gltf(lie_path, options), wp::Error);
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].max_triangles, 4u);  // the index lists still count (their data is there)
+
+  options.check_counts = [](const wp::LoadCounts& c) {
+    throw wp::Error("refused at " + std::to_string(c.triangles) + " triangles");
+  };
+  const std::string path = g.write("counts_refused.gltf");
+  try {
+    wp::load_gltf(path, options);
+    ADD_FAILURE() << "not refused";
+  } catch (const wp::Error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": refused at 4 triangles");
+  }
+}
+
 TEST(GltfLoader, FramingCamera) {
   wp::Scene s;
   s.bounds_lo = vec3(-1, 0, -3);
@@ -277,27 +327,27 @@ TEST(GltfLoader, MaterialVariantsSelectMaterials) {
   EXPECT_EQ(plain.variant, "");
   ASSERT_EQ(plain.materials.size(), 4u);  // m0, m1, m2 and the default for B
   EXPECT_EQ(plain.triangle_material, (std::vector<std::uint32_t>{0, 3, 0}));
-  EXPECT_EQ(wp::load_gltf(path, {""}).digest, plain.digest);
+  EXPECT_EQ(wp::load_gltf(path, wp::LoadOptions{""}).digest, plain.digest);
   std::set<std::uint64_t> digests = {plain.digest};
   for (const auto& [variant, materials] :
        std::vector<std::pair<std::string, std::vector<std::uint32_t>>>{
            {"red", {1, 3, 0}}, {"green", {2, 3, 0}}, {"blue", {2, 1, 0}}}) {
     SCOPED_TRACE(variant);
-    const wp::Scene s = wp::load_gltf(path, {variant});
+    const wp::Scene s = wp::load_gltf(path, wp::LoadOptions{variant});
     check_invariants(s);
     EXPECT_EQ(s.variant, variant);
     EXPECT_EQ(s.variants, plain.variants);
     EXPECT_EQ(s.triangle_material, materials);
     EXPECT_EQ(s.materials.size(), variant == "blue" ? 3u : 4u);  // the default: B's own
     EXPECT_TRUE(digests.insert(s.digest).second) << "digest shared with another variant";
-    EXPECT_EQ(wp::load_gltf(path, {variant}).digest, s.digest);  // and stable
+    EXPECT_EQ(wp::load_gltf(path, wp::LoadOptions{variant}).digest, s.digest);  // and stable
   }
 }
 
-// The error of load_gltf(path, {variant}), which must be one line naming the file.
+// The error of load_gltf(path, LoadOptions{variant}), which must be one line naming the file.
 std::string variant_error(const std::string& path, const std::string& variant) {
   try {
-    wp::load_gltf(path, {variant});
+    wp::load_gltf(path, wp::LoadOptions{variant});
   } catch (const wp::Error& e) {
     const std::string what = e.what();
     EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
