@@ -60,9 +60,8 @@ void text_geometry(std::ostringstream& o, const Scene& s) {
            " node(s): instances, each a copy of its mesh's triangles");
   if (g.gpu_instanced_nodes)
     line(o, "",
-         "EXT_mesh_gpu_instancing (ignored): " + std::to_string(g.gpu_instances) +
-             " instances on " + std::to_string(g.gpu_instanced_nodes) +
-             " node(s) not loaded; each such node's mesh is placed once");
+         "EXT_mesh_gpu_instancing: " + std::to_string(g.gpu_instances) + " instances on " +
+             std::to_string(g.gpu_instanced_nodes) + " node(s), each a copy of its mesh");
 }
 
 void text_materials(std::ostringstream& o, const Scene& s, const SceneInfo& info) {

@@ -23,8 +23,8 @@ const std::vector<KnownExtension>& known_extensions() {
   static const std::vector<KnownExtension> kTable = [] {
     std::vector<KnownExtension> t = {
         {"EXT_lights_image_based", false, "the image-based light is not used (give --env)"},
-        {"EXT_mesh_gpu_instancing", false,
-         "each node's mesh is placed once, at the node's own transform; the instances are not"},
+        {"EXT_mesh_gpu_instancing", true,
+         "every instance placed, each a copy of the mesh's triangles (no two-level BVH yet)"},
         {"EXT_meshopt_compression", false,
          "compressed buffer views are not decoded: their fallback buffers are read"},
         {"EXT_texture_avif", false,

@@ -281,7 +281,7 @@ class SceneBuilder {
   // world transform: visit(node, world). Throws for missing nodes, cycles and nodes reached twice.
   template <class Visit>
   void walk(int scene_index, Visit&& visit) const;
-  void count_mesh(int mesh, LoadCounts& counts) const;
+  void count_mesh(int mesh, std::uint64_t copies, LoadCounts& counts) const;
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
   void count_placement(const tinygltf::Node& node);
@@ -332,10 +332,10 @@ void SceneBuilder::walk(int scene_index, Visit&& visit) const {
   }
 }
 
-// One placement of mesh `mesh` in `counts`. A mesh, primitive or accessor that does not exist or
-// cannot be read counts nothing: build() reports it.
-void SceneBuilder::count_mesh(int mesh, LoadCounts& counts) const {
-  ++counts.placements;
+// `copies` placements of mesh `mesh` in `counts`. A mesh, primitive or accessor that does not exist
+// or cannot be read counts nothing: build() reports it.
+void SceneBuilder::count_mesh(int mesh, std::uint64_t copies, LoadCounts& counts) const {
+  counts.placements += copies;
   if (mesh < 0 || static_cast<std::size_t>(mesh) >= model_.meshes.size()) return;
   for (const tinygltf::Primitive& p : model_.meshes[static_cast<std::size_t>(mesh)].primitives) {
     const auto position = p.attributes.find("POSITION");
@@ -343,10 +343,10 @@ void SceneBuilder::count_mesh(int mesh, LoadCounts& counts) const {
     const std::uint64_t n =
         gltf::readable_count(model_, p.indices >= 0 ? p.indices : position->second);
     if (p.mode < 0 || p.mode == TINYGLTF_MODE_TRIANGLES) {
-      counts.triangles += n / 3;
-      counts.max_triangles += n / 3;
+      counts.triangles += copies * (n / 3);
+      counts.max_triangles += copies * (n / 3);
     } else if (n >= 3) {
-      counts.max_triangles += n - 2;
+      counts.max_triangles += copies * (n - 2);
     }
   }
 }
@@ -354,8 +354,8 @@ void SceneBuilder::count_mesh(int mesh, LoadCounts& counts) const {
 LoadCounts SceneBuilder::count(int scene_index) const {
   LoadCounts counts;
   walk(scene_index, [&](int node, const glm::dmat4&) {
-    const int mesh = model_.nodes[static_cast<std::size_t>(node)].mesh;
-    if (mesh >= 0) count_mesh(mesh, counts);
+    const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(node)];
+    if (n.mesh >= 0) count_mesh(n.mesh, gltf::placements(model_, n), counts);
   });
   return counts;
 }
@@ -381,7 +381,10 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
   const std::string where = "node " + std::to_string(node_index) + ": ";
   try {
     if (node.mesh >= 0) {
-      add_mesh(node.mesh, world);
+      if (const auto instances = gltf::instance_transforms(model_, node, node_index))
+        for (const glm::dmat4& instance : *instances) add_mesh(node.mesh, world * instance);
+      else
+        add_mesh(node.mesh, world);
       count_placement(node);
     }
     if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
@@ -428,9 +431,8 @@ void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
   }
 }
 
-// GltfSummary's counts for a node that places a mesh. EXT_mesh_gpu_instancing is ignored (not
-// loaded), so its instances are counted, from the first attribute's accessor (the extension's
-// attributes all have the instance count), and nothing in it is an error.
+// GltfSummary's counts for a node that places a mesh: its EXT_mesh_gpu_instancing instances from
+// the first attribute's accessor (instance_transforms has checked them all).
 void SceneBuilder::count_placement(const tinygltf::Node& node) {
   GltfSummary& summary = scene_.gltf;
   ++summary.mesh_nodes;

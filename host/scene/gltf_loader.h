@@ -12,10 +12,10 @@ namespace wp {
 
 // What the default scene of a file will load, counted from its node tree and its accessors'
 // counts before any vertex is read or any array allocated. Every mesh node places a copy of its
-// mesh (EXT_mesh_gpu_instancing, ignored, places one), so a mesh of T triangles placed by N nodes
-// counts N x T.
+// mesh, once per EXT_mesh_gpu_instancing instance where it has them, so a mesh of T triangles
+// placed by N nodes counts N x T.
 struct LoadCounts {
-  std::uint64_t placements = 0;  // nodes of the default scene with a mesh
+  std::uint64_t placements = 0;  // copies of meshes the default scene's nodes place
   // Triangles: at least `triangles` (triangle lists: indices / 3, or vertices / 3 without indices;
   // strips and fans count 0, as they may be all degenerate) and at most `max_triangles` (strips
   // and fans: n - 2). Only accessors whose data lies in the file count (an accessor without a

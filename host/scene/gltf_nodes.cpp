@@ -11,6 +11,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "host/util/error.h"
+#include "host/scene/gltf_accessor.h"
 #include "host/scene/gltf_values.h"
 
 namespace wp::gltf {
@@ -46,7 +47,106 @@ void orientation(const glm::dmat4& world, glm::vec3* forward, glm::vec3* up) {
   *up = glm::vec3(glm::normalize(u));
 }
 
+constexpr const char* kInstancing = "EXT_mesh_gpu_instancing";
+
+// The extension's attributes object of `node`, or null without the extension.
+const tinygltf::Value* instancing_attributes(const tinygltf::Node& node, const std::string& where) {
+  const auto it = node.extensions.find(kInstancing);
+  if (it == node.extensions.end()) return nullptr;
+  const tinygltf::Value& ext = it->second;
+  if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject())
+    throw Error(where + ": " + kInstancing + " has no attributes object");
+  return &ext.Get("attributes");
+}
+
 }  // namespace
+
+std::optional<std::vector<glm::dmat4>> instance_transforms(const tinygltf::Model& model,
+                                                           const tinygltf::Node& node, int index) {
+  const std::string where = "node " + std::to_string(index) + ": " + kInstancing;
+  const tinygltf::Value* attributes = instancing_attributes(node, "node " + std::to_string(index));
+  if (!attributes) return std::nullopt;
+  constexpr unsigned kSnorm =
+      component_bit(TINYGLTF_COMPONENT_TYPE_BYTE) | component_bit(TINYGLTF_COMPONENT_TYPE_SHORT);
+  const AccessorSpec kTranslation{"TRANSLATION", 3, 3, kFloatBit};
+  const AccessorSpec kRotation{"ROTATION", 4, 4, kFloatBit | kSnorm};
+  const AccessorSpec kScale{"SCALE", 3, 3, kFloatBit};
+  std::optional<AccessorReader> t, r, s;
+  std::optional<std::size_t> count;
+  for (const std::string& name : attributes->Keys()) {
+    const tinygltf::Value& v = attributes->Get(name);
+    if (!v.IsInt()) throw Error(where + ": attribute " + name + " is not an accessor index");
+    const int accessor = v.GetNumberAsInt();
+    const AccessorSpec* spec = name == "TRANSLATION" ? &kTranslation
+                               : name == "ROTATION"  ? &kRotation
+                               : name == "SCALE"     ? &kScale
+                                                     : nullptr;
+    std::optional<AccessorReader>& slot = name == "TRANSLATION" ? t : name == "ROTATION" ? r : s;
+    std::size_t n = 0;
+    if (spec) {
+      try {
+        slot.emplace(model, accessor, *spec);
+      } catch (const Error& e) {
+        throw Error(where + ": " + e.what());
+      }
+      if (name == "ROTATION" && !model.accessors[static_cast<std::size_t>(accessor)].normalized &&
+          model.accessors[static_cast<std::size_t>(accessor)].componentType !=
+              TINYGLTF_COMPONENT_TYPE_FLOAT)
+        throw Error(where + ": ROTATION of integer components must be normalized");
+      n = slot->count();
+    } else {  // a custom attribute ("_ID"): only its count matters
+      if (accessor < 0 || static_cast<std::size_t>(accessor) >= model.accessors.size())
+        throw Error(where + ": attribute " + name + ": accessor " + std::to_string(accessor) +
+                    " does not exist");
+      n = model.accessors[static_cast<std::size_t>(accessor)].count;
+    }
+    if (count && n != *count)
+      throw Error(where + ": attribute " + name + " has " + std::to_string(n) +
+                  " instances, another has " + std::to_string(*count) + " (counts must be equal)");
+    count = n;
+  }
+  if (!count) throw Error(where + ": no attributes");
+  std::vector<glm::dmat4> out(*count, glm::dmat4(1.0));
+  for (std::size_t i = 0; i < *count; ++i) {
+    float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    glm::dmat4 m(1.0);
+    if (t) {
+      t->read(i, f);
+      m = glm::translate(m, glm::dvec3(f[0], f[1], f[2]));
+    }
+    if (r) {
+      r->read(i, f);
+      const glm::dquat q(f[3], f[0], f[1], f[2]);  // glm: w first; glTF stores x, y, z, w
+      const double len = glm::length(q);
+      if (!(len > 0.0) || !std::isfinite(len))
+        throw Error(where + ": ROTATION " + std::to_string(i) + " is not a rotation");
+      m = m * glm::mat4_cast(q / len);
+    }
+    if (s) {
+      s->read(i, f);
+      m = glm::scale(m, glm::dvec3(f[0], f[1], f[2]));
+    }
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k)
+        if (!std::isfinite(m[c][k]))
+          throw Error(where + ": instance " + std::to_string(i) + " has a non-finite transform");
+    out[i] = m;
+  }
+  return out;
+}
+
+std::size_t placements(const tinygltf::Model& model, const tinygltf::Node& node) {
+  const auto it = node.extensions.find(kInstancing);
+  if (it == node.extensions.end()) return 1;
+  const tinygltf::Value& ext = it->second;
+  if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject()) return 0;
+  const tinygltf::Value& attributes = ext.Get("attributes");
+  for (const std::string& name : attributes.Keys())
+    if (attributes.Get(name).IsInt())
+      if (const std::size_t n = readable_count(model, attributes.Get(name).GetNumberAsInt()))
+        return n;
+  return 0;
+}
 
 glm::dmat4 local_transform(const tinygltf::Node& node, int index) {
   const std::string where = "node " + std::to_string(index);

@@ -165,8 +165,8 @@ struct GltfSummary {
   std::size_t meshes_placed = 0;  // distinct meshes the default scene's nodes place
   // Nodes of the default scene with a mesh: each places a copy of its mesh's triangles.
   std::size_t mesh_nodes = 0;
-  // EXT_mesh_gpu_instancing (ignored, gltf_extensions.h): the nodes of mesh_nodes that have it and
-  // their instances in all, which are not loaded (each such node places its mesh once).
+  // EXT_mesh_gpu_instancing: the nodes of mesh_nodes that have it and their instances in all (such
+  // a node places a copy of its mesh per instance, and none where it has no instance).
   std::size_t gpu_instanced_nodes = 0, gpu_instances = 0;
   std::size_t images = 0, textures = 0;  // in the file (Scene::images: those materials use)
   std::size_t materials = 0;  // in the file (Scene::materials adds glTF's default one if used)

@@ -20,6 +20,37 @@ TEST(GltfAssets, Box) {
   EXPECT_TRUE(near(s.bounds_hi, vec3(0.5f)));
 }
 
+// SimpleInstancing (its README): one unit cube placed by EXT_mesh_gpu_instancing 125 times in a
+// 5 x 5 x 5 grid, translations 0 to 10, scales 1 to 2, rotations "from 0 to 90 degrees along each
+// axis": the first instance is the unmodified unit cube; the last is at (10, 10, 10), scaled by 2
+// and turned 90 degrees about each axis, which is the file's quaternion (0.5, 0.5, 0.5, 0.5): 120
+// degrees about (1, 1, 1), the rotation taking x to y, y to z and z to x. (The README's "rotated
+// around the axis (1, 1, 1) by 90 degrees" is loose wording for it.)
+TEST(GltfAssets, SimpleInstancing) {
+  WP_REQUIRE_MODEL(path, "SimpleInstancing/SimpleInstancing.glb");
+  const wp::Scene s = wp::load_gltf(path);
+  check_invariants(s);
+  EXPECT_TRUE(s.warnings.empty());
+  ASSERT_EQ(s.triangle_count(), 125u * 12u);
+  EXPECT_EQ(s.gltf.gpu_instances, 125u);
+  const auto corners_of = [&](std::size_t instance) {  // the instance's 12 triangles' corners
+    std::vector<vec3> out;
+    for (std::size_t t = 12 * instance; t < 12 * instance + 12; ++t)
+      for (int c = 0; c < 3; ++c) out.push_back(corner(s, t, c));
+    return out;
+  };
+  const std::vector<vec3> first = corners_of(0), last = corners_of(124);
+  const auto has = [](const std::vector<vec3>& corners, const vec3& p) {
+    return std::any_of(corners.begin(), corners.end(), [&](const vec3& x) { return near(x, p); });
+  };
+  for (int k = 0; k < 8; ++k) {  // each corner of the unit cube is some triangle's corner
+    const vec3 c(float(k & 1), float((k >> 1) & 1), float((k >> 2) & 1));
+    EXPECT_TRUE(has(first, c)) << k;
+    const vec3 turned(c.z, c.x, c.y);  // x -> y, y -> z, z -> x
+    EXPECT_TRUE(has(last, vec3(10.0f) + 2.0f * turned)) << k;
+  }
+}
+
 TEST(GltfAssets, Cameras) {
   WP_REQUIRE_MODEL(path, "Cameras/Cameras.gltf");
   const wp::Scene s = wp::load_gltf(path);

@@ -3,6 +3,9 @@
 // Shared fixture: tests/gltf/gltf_files.h.
 #include <set>
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/matrix.hpp>
+
 #include "tests/gltf/gltf_files.h"
 
 namespace {
@@ -33,17 +36,17 @@ TEST(GltfLoader, DefaultScene) {
 // not be).
 TEST(GltfLoader, ExtensionWarnings) {
   Gltf g = one_triangle("");
-  g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing","KHR_materials_volume",)"
+  g.top = R"("extensionsUsed":["KHR_animation_pointer","KHR_materials_volume",)"
           R"("KHR_texture_transform","KHR_materials_unlit","KHR_materials_sheen"],)"
           R"("textures":[{"source":0}],"images":[{"uri":"data:image/png;base64,AAAA"}])";
   const wp::Scene s = wp::load_gltf(g.write("warn.gltf"));
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("EXT_mesh_gpu_instancing"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("KHR_animation_pointer"), std::string::npos) << s.warnings[0];
   EXPECT_TRUE(s.images.empty());
 }
 
-// GltfSummary: mesh 0 placed by two nodes (one with 3 EXT_mesh_gpu_instancing instances, which
-// are not loaded), mesh 1 by none, a third node with no mesh; the file's lists as it has them.
+// GltfSummary: mesh 0 placed by two nodes (one with 3 EXT_mesh_gpu_instancing instances, each a
+// copy), mesh 1 by none, a third node with no mesh; the file's lists as it has them.
 TEST(GltfLoader, Summary) {
   Gltf g = one_triangle("");
   g.mesh({prim({{"POSITION", 0}})});
@@ -55,7 +58,7 @@ TEST(GltfLoader, Summary) {
   g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing","KHR_texture_transform"],)"
           R"("extensionsRequired":["KHR_texture_transform"])";
   const wp::Scene s = wp::load_gltf(g.write("summary.gltf"));
-  EXPECT_EQ(s.triangle_count(), 2u);
+  EXPECT_EQ(s.triangle_count(), 1u + 3u);
   EXPECT_EQ(s.gltf.meshes, 2u);
   EXPECT_EQ(s.gltf.meshes_placed, 1u);
   EXPECT_EQ(s.gltf.mesh_nodes, 2u);
@@ -66,6 +69,96 @@ TEST(GltfLoader, Summary) {
   EXPECT_EQ(s.gltf.extensions_required, std::vector<std::string>{"KHR_texture_transform"});
   EXPECT_EQ(s.gltf.materials, 0u);
   EXPECT_EQ(s.materials.size(), 1u);  // glTF's default material
+}
+
+// EXT_mesh_gpu_instancing: the node places its mesh once per instance, at node world x T x R x S
+// (the extension's order), with ROTATION as normalized shorts and a mirroring SCALE among them:
+// each instance's corners against that product in double, its winding kept counter-clockwise
+// (the face normal is the transformed one's direction), and the counts before loading multiplied.
+TEST(GltfLoader, GpuInstancesArePlaced) {
+  Gltf g;
+  const int pos = g.vec3s({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  g.mesh({prim({{"POSITION", pos}})});
+  const int t = g.vec3s({{0, 0, 0}, {5, 0, 0}, {0, 5, 0}});
+  // Quaternions (x, y, z, w) x 32767: identity, 90 degrees about +Z, 180 degrees about +X.
+  const int r = g.accessor(
+      g.view(std::vector<std::int16_t>{0, 0, 0, 32767, 0, 0, 23170, 23170, 32767, 0, 0, 0}), 5122,
+      3, "VEC4", R"(,"normalized":true)");
+  const int sc = g.vec3s({{1, 1, 1}, {2, 2, 2}, {-1, 1, 1}});
+  g.node(R"("mesh":0,"translation":[0,0,-3],"extensions":{"EXT_mesh_gpu_instancing":)"
+         R"({"attributes":{"TRANSLATION":)" +
+             std::to_string(t) + R"(,"ROTATION":)" + std::to_string(r) + R"(,"SCALE":)" +
+             std::to_string(sc) + "}}}",
+         true);
+  g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing"])";
+  wp::LoadOptions options;
+  std::uint64_t counted = 0;
+  options.check_counts = [&](const wp::LoadCounts& c) { counted = c.placements; };
+  const wp::Scene s = wp::load_gltf(g.write("instances.gltf"), options);
+  check_invariants(s);
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(counted, 3u);
+  ASSERT_EQ(s.triangle_count(), 3u);
+  const auto rotation = [](double angle, glm::dvec3 axis) {
+    return glm::rotate(glm::dmat4(1.0), angle, axis);
+  };
+  const glm::dmat4 node = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, -3));
+  const double half_pi = std::acos(0.0);
+  // Rotation 1 is the normalized shorts' quaternion (0, 0, q, q), q = 23170 / 32767 = 0.707107,
+  // renormalised: 90 degrees about +Z exactly.
+  const glm::dmat4 instances[3] = {
+      glm::dmat4(1.0),
+      glm::translate(glm::dmat4(1.0), glm::dvec3(5, 0, 0)) * rotation(half_pi, {0, 0, 1}) *
+          glm::scale(glm::dmat4(1.0), glm::dvec3(2.0)),
+      glm::translate(glm::dmat4(1.0), glm::dvec3(0, 5, 0)) * rotation(2 * half_pi, {1, 0, 0}) *
+          glm::scale(glm::dmat4(1.0), glm::dvec3(-1, 1, 1))};
+  const vec3 local[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (std::size_t i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    const glm::dmat4 m = node * instances[i];
+    // A mirrored triangle has two corners swapped (winding kept): compare the corners as a set.
+    std::vector<vec3> got;
+    for (int c = 0; c < 3; ++c) got.push_back(corner(s, i, c));
+    for (const vec3& p : local) {
+      const vec3 e(m * glm::dvec4(glm::dvec3(p), 1.0));
+      EXPECT_TRUE(
+          std::any_of(got.begin(), got.end(), [&](const vec3& x) { return near(x, e, 1e-5f); }))
+          << e.x << " " << e.y << " " << e.z;
+    }
+    // The front: normals go by the inverse transpose, mirrored or not.
+    const glm::dvec3 n =
+        glm::normalize(glm::transpose(glm::inverse(glm::dmat3(m))) * glm::dvec3(0, 0, 1));
+    EXPECT_TRUE(near(geometric_normal(s, i), vec3(n), 1e-5f));
+  }
+  EXPECT_LT(glm::determinant(glm::dmat3(node * instances[2])), 0.0);  // the mirrored one
+}
+
+// EXT_mesh_gpu_instancing's rules: attribute counts equal, integer rotations normalized, an
+// attributes object; each broken one is an error naming the node and the extension.
+TEST(GltfLoader, MalformedGpuInstancingIsAnError) {
+  const auto error = [](const std::string& ext, const std::string& name) {
+    Gltf g = one_triangle(R"("extensions":{"EXT_mesh_gpu_instancing":)" + ext + "}");
+    g.vec3s({{0, 0, 0}, {1, 0, 0}});  // accessor 1: 2 items
+    g.vec3s({{0, 0, 0}});             // accessor 2: 1 item
+    g.accessor(g.view(std::vector<std::int8_t>{0, 0, 0, 127}), 5120, 1,
+               "VEC4");  // 3: not normalized
+    try {
+      wp::load_gltf(g.write(name));
+    } catch (const wp::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  for (const auto& [ext, cause] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"attributes":{"TRANSLATION":1,"SCALE":2}})", "counts must be equal"},
+           {R"({"attributes":{"ROTATION":3}})", "must be normalized"},
+           {R"({})", "no attributes object"},
+           {R"({"attributes":{}})", "no attributes"},
+           {R"({"attributes":{"TRANSLATION":9}})", "does not exist"}}) {
+    const std::string e = error(ext, "bad_instancing.gltf");
+    EXPECT_NE(e.find("node 0: EXT_mesh_gpu_instancing"), std::string::npos) << e;
+    EXPECT_NE(e.find(cause), std::string::npos) << ext << ": " << e;
+  }
 }
 
 // LoadOptions::check_counts sees the default scene's counts before any geometry is loaded: each
