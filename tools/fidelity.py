@@ -331,7 +331,8 @@ def render_wavepath(a, scene, work, name):
     cmd = ([a.wavepath, "render", scene, "--width", str(a.width), "--height", str(a.height),
             "--spp", str(a.spp), "--seed", str(al.REFERENCE_SEED), "--max-depth",
             str(a.max_depth), "--rr-depth", str(a.rr_depth), "-o", out, "--variance",
-            "--progress-every", "3600"] + env_args(a) + al.config_args("mis"))
+            "--progress-every", "3600", "--mipmaps", a.mipmaps] + env_args(a)
+           + al.config_args("mis"))
     rc, _, err, t = run(cmd)
     if rc != 0:
         lines = [l for l in err.splitlines() if "error:" in l] or err.strip().splitlines()[-1:]
@@ -634,8 +635,9 @@ def write_page(a, rows, zero_rows, info):
     L += ["How each renderer gets the file: wavepath renders it as it is; Cycles imports it "
           "with Blender's glTF importer, set up as `tools/peers.py --pbr` does (every "
           "Principled BSDF single-scatter GGX, subsurface off, back faces of single-sided "
-          "materials transparent, the map as the world with the same orientation and "
-          "nearest-texel lookup, a one-pixel box filter, max bounces = max depth − 1, no "
+          "materials transparent, the map as the world with the same orientation, every image "
+          "looked up with Blender's default Linear interpolation (wavepath: bilinear "
+          "environment, its default `--env-filter`, and %s), a one-pixel box filter, max bounces = max depth − 1, no "
           "clamping, denoising or adaptive sampling, light tree off), with punctual lights in "
           "wavepath's units (below). A file without a camera is rendered by both from a copy "
           "with wavepath's framing camera written into it (`peers_scene.with_camera`); "
@@ -643,7 +645,10 @@ def write_page(a, rows, zero_rows, info):
           "default materials in both. A file that *requires* an extension the renderer does not "
           "have is refused; where Blender's importer refuses one, Cycles renders a copy with "
           "that extension merely optional (so ignored, as the importer ignores it elsewhere), "
-          "marked in the table.", ""]
+          "marked in the table."
+          % ("textures at full resolution, `--mipmaps off`, as Cycles looks them up on the CPU"
+             if a.mipmaps == "off" else
+             "mip-mapped textures, `--mipmaps on`, where Cycles' are at full resolution"), ""]
     other = info.get("other")
     L += ["Machine: %s, %d cores; both render on the CPU. Versions: Blender %s (glTF importer "
           "%s); wavepath `%s` (%s). This run: %s; %.0f s in all, Cycles' images %d rendered and "
@@ -803,6 +808,11 @@ def parse_args(argv):
     p.add_argument("--zero", action="append", default=[], metavar="EXT",
                    help="diagnostic: also render copies with EXT off (see below)")
     p.add_argument("--wavepath", default=os.path.join(REPO, "build", "wavepath"))
+    p.add_argument("--mipmaps", choices=("on", "off"), default="off",
+                   help="wavepath's --mipmaps (default off: Cycles on the CPU looks its image "
+                        "textures up at full resolution, so that both converge to the same "
+                        "image; with on, the difference includes the bias of wavepath's "
+                        "texture filtering, measured on its own in docs/performance.md)")
     p.add_argument("--venv", default=os.path.join(REPO, "build", "peers-venv"))
     p.add_argument("--python", default=default_python(),
                    help="interpreter the venv is created with (default: python3.11 if found)")
