@@ -7,12 +7,15 @@
 #include <string>
 
 #include <stb_image.h>
+#include <webp/decode.h>
 
+#include "host/scene/gltf_json.h"
 #include "host/util/error.h"
 
 namespace wp::gltf {
 namespace {
 
+constexpr std::uint64_t kNoSource = ~std::uint64_t{0};
 constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728,
               kLinear = 9729;  // magnification filters, and minification without mip-maps
 
@@ -111,6 +114,59 @@ void check_png_chunks(const unsigned char* bytes, std::size_t size, const std::s
   }
 }
 
+// At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before any decoder allocates them.
+void check_texels(int width, int height, const std::string& what) {
+  if (double(width) * double(height) > double(1u << 28))
+    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
+                " pixels, more than the 16384 x 16384 a texture may have");
+}
+
+bool is_webp(const unsigned char* bytes, std::size_t size) {
+  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
+}
+
+// A WebP image (EXT_texture_webp) as RGBA8: its header read and its size checked before the
+// texels are allocated, then decoded into them. An animation is refused (a texture is one image).
+void decode_webp(const unsigned char* bytes, std::size_t size, const std::string& what,
+                 Image& out) {
+  int width = 0, height = 0;
+  if (!WebPGetInfo(bytes, size, &width, &height))
+    throw Error(what + ": not a WebP image libwebp can read (bad or truncated header)");
+  WebPBitstreamFeatures features;
+  if (WebPGetFeatures(bytes, size, &features) != VP8_STATUS_OK)
+    throw Error(what + ": not a WebP image libwebp can read (bad or truncated header)");
+  if (features.has_animation)
+    throw Error(what + ": an animated WebP image (a texture is one still image)");
+  if (width <= 0 || height <= 0)
+    throw Error(what + ": WebP image of " + std::to_string(width) + " x " + std::to_string(height) +
+                " pixels");
+  check_texels(width, height, what);
+  const std::size_t row = 4 * std::size_t(width);
+  out.rgba.assign(row * std::size_t(height), 0);
+  if (!WebPDecodeRGBAInto(bytes, size, out.rgba.data(), out.rgba.size(), static_cast<int>(row)))
+    throw Error(what + ": cannot decode the WebP data (corrupt or truncated)");
+  out.width = width;
+  out.height = height;
+}
+
+// A PNG or JPEG (or another format stb_image reads) as RGBA8.
+void decode_stb(const unsigned char* bytes, std::size_t size, const std::string& what, Image& out) {
+  check_png_chunks(bytes, size, what);
+  int width = 0, height = 0, channels = 0;
+  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels))
+    check_texels(width, height, what);
+  unsigned char* pixels =
+      stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    throw Error(what + ": cannot decode: " + (reason ? reason : "unknown format"));
+  }
+  out.width = width;
+  out.height = height;
+  out.rgba.assign(pixels, pixels + std::size_t(4) * std::size_t(width) * std::size_t(height));
+  stbi_image_free(pixels);
+}
+
 }  // namespace
 
 bool keep_encoded_image(tinygltf::Image* image, int, std::string*, std::string*, int, int,
@@ -184,12 +240,24 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
            " is not supported (only 0 and 1); texture ignored");
     return false;
   }
-  if (texture.source < 0) {  // e.g. only an extension's source (KTX2, WebP)
-    if (warn_unusable) warn(tex_where + " has no PNG or JPEG source; ignored");
+  // EXT_texture_webp's source is the image to use; `source` is a fallback for viewers without it.
+  // KHR_texture_basisu's KTX2 images have no decoder here (none in Debian): its fallback `source`
+  // is used, and a texture in use without one is an error naming the extension.
+  std::uint64_t source = texture.source < 0 ? kNoSource : std::uint64_t(texture.source);
+  if (const tinygltf::Value* webp =
+          extension_object(texture.extensions, "EXT_texture_webp", tex_where))
+    source = count_member(*webp, "source", tex_where + ": EXT_texture_webp", true);
+  if (source == kNoSource) {  // e.g. only an extension's source (KTX2, AVIF)
+    if (!warn_unusable) return false;
+    if (texture.extensions.count("KHR_texture_basisu"))
+      throw Error(tex_where +
+                  ": KHR_texture_basisu (KTX2) images cannot be decoded and the "
+                  "texture has no fallback source");
+    warn(tex_where + " has no PNG, JPEG or WebP source; ignored");
     return false;
   }
-  if (static_cast<std::size_t>(texture.source) >= model_.images.size())
-    throw Error(tex_where + ": image " + std::to_string(texture.source) + " does not exist");
+  if (source >= model_.images.size())
+    throw Error(tex_where + ": image " + std::to_string(source) + " does not exist");
   if (texture.sampler >= 0) {
     if (static_cast<std::size_t>(texture.sampler) >= model_.samplers.size())
       throw Error(tex_where + ": sampler " + std::to_string(texture.sampler) + " does not exist");
@@ -209,7 +277,7 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
   }
   ref.srgb = srgb;
   ref.texcoord = texcoord;
-  ref.image = texture.source;
+  ref.image = static_cast<int>(source);
   return true;
 }
 
@@ -254,25 +322,12 @@ int TextureTable::image(int index) {
   }
   if (size == 0) throw Error(what + ": no image data (file missing or unreadable?)");
   if (size > static_cast<std::size_t>(INT_MAX)) throw Error(what + ": larger than 2 GiB");
-  check_png_chunks(bytes, size, what);
-  int width = 0, height = 0, channels = 0;
-  // At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before stb_image allocates them.
-  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels) &&
-      double(width) * double(height) > double(1u << 28))
-    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
-                " pixels, more than the 16384 x 16384 a texture may have");
-  unsigned char* pixels =
-      stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
-  if (!pixels) {
-    const char* reason = stbi_failure_reason();
-    throw Error(what + ": cannot decode: " + (reason ? reason : "unknown format"));
-  }
   Image out;
+  if (is_webp(bytes, size))
+    decode_webp(bytes, size, what, out);
+  else
+    decode_stb(bytes, size, what, out);
   out.name = in.name.empty() ? in.uri.substr(0, 64) : in.name;
-  out.width = width;
-  out.height = height;
-  out.rgba.assign(pixels, pixels + std::size_t(4) * std::size_t(width) * std::size_t(height));
-  stbi_image_free(pixels);
   slot = static_cast<int>(scene_.images.size());
   scene_.images.push_back(std::move(out));
   return slot;
