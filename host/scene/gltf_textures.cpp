@@ -149,8 +149,20 @@ void decode_webp(const unsigned char* bytes, std::size_t size, const std::string
   out.height = height;
 }
 
-// A PNG or JPEG (or another format stb_image reads) as RGBA8.
+bool is_png_or_jpeg(const unsigned char* bytes, std::size_t size) {
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return (size >= 8 && std::memcmp(bytes, kPng, 8) == 0) ||
+         (size >= 3 && bytes[0] == 0xff && bytes[1] == 0xd8 && bytes[2] == 0xff);
+}
+
+// A PNG or JPEG as RGBA8. Only those two: stb_image would take anything else as one of its other
+// formats, TGA among them, whose header has no signature (fuzzing: 18 bytes read as a 4608 x 47698
+// TGA made it allocate 880 MB and fill it for seconds).
 void decode_stb(const unsigned char* bytes, std::size_t size, const std::string& what, Image& out) {
+  if (!is_png_or_jpeg(bytes, size))
+    throw Error(what +
+                ": not a PNG, JPEG or WebP image (the formats glTF and EXT_texture_webp "
+                "allow)");
   check_png_chunks(bytes, size, what);
   int width = 0, height = 0, channels = 0;
   if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels))

@@ -374,6 +374,11 @@ TEST(CompressedEdges, WebpImages) {
                                      'B',  'P', 'V', 'P', '8', 'X', 10, 0, 0,   0,
                                      0x02, 0,   0,   0,   1,   0,   0,  1, 0,   0};
   expect_error(textured_quad("webp_anim.glb", anim, webp_texture(0)), "animated");
+  // Found by fuzz_webp: 18 bytes that stb_image read as a 4608 x 47698 TGA (no signature), 880 MB
+  // filled for seconds. Only PNG, JPEG and WebP are decoded.
+  const std::vector<unsigned char> tga = {0, 0, 2, 0x3a, 0,    0x7a, 0,    0,    0,
+                                          0, 0, 0, 0,    0x12, 0x52, 0xba, 0x10, 0x7c};
+  expect_error(textured_quad("tga.glb", tga, webp_texture(0)), "not a PNG, JPEG or WebP image");
   std::vector<unsigned char> junk = webp;
   for (std::size_t i = 12; i < junk.size(); ++i) junk[i] = static_cast<unsigned char>(i * 37);
   EXPECT_FALSE(loads(textured_quad("webp_junk.glb", junk, webp_texture(0))));
