@@ -1,5 +1,6 @@
 #include "host/scene/gltf_textures.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdio>
@@ -149,6 +150,44 @@ void decode_webp(const unsigned char* bytes, std::size_t size, const std::string
   out.height = height;
 }
 
+// A JPEG's Huffman tables (DHT segments), walked before stb_image sees the file: each table may
+// have at most 256 codes. Debian's stb_image (2.27) copies a table's code sizes into a 257-byte
+// array and its values into a 256-byte one without checking the 16 counts' sum, up to 4,080
+// (fuzz_webp: a 40-byte JPEG wrote past both, UBSan). The walk follows the marker segments by
+// their lengths and, after a scan's header, skips entropy-coded bytes to the next marker, as
+// stb_image does; counts past the end of the file read as 0, as stb_image reads them. Not a JPEG:
+// nothing to check.
+void check_jpeg_tables(const unsigned char* bytes, std::size_t size, const std::string& what) {
+  if (size < 2 || bytes[0] != 0xff || bytes[1] != 0xd8) return;
+  const auto byte = [&](std::size_t at) -> std::size_t { return at < size ? bytes[at] : 0; };
+  std::size_t at = 2;
+  while (at + 1 < size) {
+    const std::size_t marker = bytes[at + 1];
+    if (bytes[at] != 0xff || marker == 0xff) {  // entropy-coded data, or a fill byte
+      ++at;
+      continue;
+    }
+    if (marker == 0xd9) break;  // end of image
+    // Markers without a segment: stuffed zero, TEM, SOI, RST0-7.
+    if (marker == 0x00 || marker == 0x01 || marker == 0xd8 || (marker >= 0xd0 && marker <= 0xd7)) {
+      at += 2;
+      continue;
+    }
+    const std::size_t length = byte(at + 2) << 8 | byte(at + 3);
+    if (marker == 0xc4) {
+      for (std::size_t table = at + 4; table < at + 2 + length;) {
+        std::size_t codes = 0;
+        for (std::size_t i = 1; i <= 16; ++i) codes += byte(table + i);
+        if (codes > 256)
+          throw Error(what + ": JPEG Huffman table at byte " + std::to_string(table) + " has " +
+                      std::to_string(codes) + " codes (at most 256)");
+        table += 17 + codes;
+      }
+    }
+    at += 2 + std::max<std::size_t>(length, 2);
+  }
+}
+
 bool is_png_or_jpeg(const unsigned char* bytes, std::size_t size) {
   static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   return (size >= 8 && std::memcmp(bytes, kPng, 8) == 0) ||
@@ -164,6 +203,7 @@ void decode_stb(const unsigned char* bytes, std::size_t size, const std::string&
                 ": not a PNG, JPEG or WebP image (the formats glTF and EXT_texture_webp "
                 "allow)");
   check_png_chunks(bytes, size, what);
+  check_jpeg_tables(bytes, size, what);
   int width = 0, height = 0, channels = 0;
   if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels))
     check_texels(width, height, what);
