@@ -310,3 +310,43 @@ TEST_F(EdgeCli, ValuesBeyondFloat32AreClampedAndRenderFinite) {
 }
 
 }  // namespace
+
+// Compressed data wavepath cannot read: a texture whose only image is KTX2 (KHR_texture_basisu, no
+// decoder in Debian) and a meshopt stream that does not decode. One line naming the cause, status
+// 1, nothing written.
+TEST_F(EdgeCli, CompressedDataThatCannotBeReadIsOneError) {
+  write_triangle_bin(dir_ / "tri.bin");
+  std::string basisu = triangle_gltf("tri.bin", "",
+                                     R"({"pbrMetallicRoughness":)"
+                                     R"({"baseColorTexture":{"index":0}}})");
+  basisu.pop_back();  // the closing brace: the texture, its KTX2 image, the extension's lists
+  basisu +=
+      R"(,"textures":[{"extensions":{"KHR_texture_basisu":{"source":0}}}],)"
+      R"("images":[{"uri":"t.ktx2","mimeType":"image/ktx2"}],)"
+      R"("extensionsUsed":["KHR_texture_basisu"],"extensionsRequired":["KHR_texture_basisu"]})";
+  std::ofstream(dir_ / "t.ktx2") << "\xabKTX 20\xbb\r\n\x1a\n";
+  std::ofstream(dir_ / "basisu.gltf") << basisu;
+  expect_error(
+      run("render basisu.gltf -o out.exr"),
+      "texture 0: KHR_texture_basisu (KTX2) images cannot be decoded and the texture has no "
+      "fallback source",
+      "KTX2 only");
+  // tri.bin as a meshopt ATTRIBUTES stream: its first byte is not the codec's header (0xa0).
+  std::string meshopt = triangle_gltf("tri.bin", "");
+  const std::string view = R"("bufferViews":[{"buffer":0,"byteLength":36}])";
+  meshopt.replace(meshopt.find(view), view.size(),
+                  R"("bufferViews":[{"buffer":1,"byteLength":36,"byteStride":12,"extensions":)"
+                  R"({"EXT_meshopt_compression":{"buffer":0,"byteLength":36,"byteStride":12,)"
+                  R"("count":3,"mode":"ATTRIBUTES"}}}])");
+  const std::string buffers = R"("buffers":[{"byteLength":36,"uri":"tri.bin"}])";
+  meshopt.replace(meshopt.find(buffers), buffers.size(),
+                  R"("buffers":[{"byteLength":36,"uri":"tri.bin"},{"byteLength":36,)"
+                  R"("extensions":{"EXT_meshopt_compression":{"fallback":true}}}],)"
+                  R"("extensionsUsed":["EXT_meshopt_compression"],)"
+                  R"("extensionsRequired":["EXT_meshopt_compression"])");
+  std::ofstream(dir_ / "meshopt.gltf") << meshopt;
+  expect_error(run("render meshopt.gltf -o out.exr"),
+               "bufferView 0 EXT_meshopt_compression: corrupt ATTRIBUTES data", "meshopt");
+  EXPECT_EQ(left_behind({"tri.bin", "t.ktx2", "basisu.gltf", "meshopt.gltf"}),
+            std::vector<std::string>{});
+}

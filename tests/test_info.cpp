@@ -204,19 +204,19 @@ TEST_F(InfoCli, ImagesAsPacked) {
 
 // A file requiring an extension wavepath lacks: the extensions on stdout, then one error line.
 TEST_F(InfoCli, RefusedFileStillListsItsExtensions) {
-  std::ofstream(dir_ / "draco.gltf")
+  std::ofstream(dir_ / "avif.gltf")
       << R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],)"
-      << R"("extensionsUsed":["KHR_draco_mesh_compression","KHR_materials_clearcoat"],)"
-      << R"("extensionsRequired":["KHR_draco_mesh_compression"]})";
-  const CliRun r = run("info draco.gltf --json");
-  expect_one_line_error(r, "requires unsupported extension KHR_draco_mesh_compression");
+      << R"("extensionsUsed":["EXT_texture_avif","KHR_materials_clearcoat"],)"
+      << R"("extensionsRequired":["EXT_texture_avif"]})";
+  const CliRun r = run("info avif.gltf --json");
+  expect_one_line_error(r, "requires unsupported extension EXT_texture_avif");
   const json j = json::parse(r.out);
   EXPECT_EQ(j["loaded"], false);
   ASSERT_EQ(j["extensions"].size(), 2u);
   EXPECT_EQ(j["extensions"][0]["status"], "refused");
   EXPECT_EQ(j["extensions"][0]["required"], true);
   EXPECT_EQ(j["extensions"][1]["status"], "supported");
-  const CliRun text = run("info draco.gltf");
+  const CliRun text = run("info avif.gltf");
   EXPECT_EQ(text.status, 1);
   EXPECT_NE(text.out.find("refused"), std::string::npos) << text.out;
 }

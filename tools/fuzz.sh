@@ -3,8 +3,12 @@
 # UndefinedBehaviorSanitizer) in build-fuzz/ and runs each for SECONDS (default 60):
 #   fuzz_gltf         wp::load_gltf on .gltf / .glb bytes
 #   fuzz_environment  wp::load_environment on .hdr (and .exr) bytes
+#   fuzz_draco, fuzz_meshopt, fuzz_webp  wp::load_gltf on a .glb around a compressed payload
+#                     (tests/fuzz/fuzz_compressed.cpp)
 # Seeds: tests/fuzz/make_seeds.py's built-in ones, plus small models and cropped .hdr maps from
-# ../shared/assets (WAVEPATH_ASSETS overrides) when that folder exists. The corpus each run grows
+# ../shared/assets (WAVEPATH_ASSETS overrides) when that folder exists; for the compressed data,
+# build-fuzz/make_compressed_seeds compresses a built-in quad and those models (Draco, meshopt,
+# WebP: twins for fuzz_gltf, payloads for the codecs' targets). The corpus each run grows
 # is kept in build-fuzz/corpus/<target>/, so later runs start where earlier ones stopped.
 #
 # Exits non-zero when a target reports a finding (a crash, a sanitizer report, an exception other
@@ -13,7 +17,7 @@
 #   build-fuzz/fuzz_gltf build-fuzz/findings/fuzz_gltf/crash-...
 # (WP_FUZZ_VERBOSE=1 prints the wp::Error an input gives).
 #
-#   tools/fuzz.sh [SECONDS [TARGET...]]   build if needed, fuzz each target (default: both) SECONDS
+#   tools/fuzz.sh [SECONDS [TARGET...]]   build if needed, fuzz each target (default: all) SECONDS
 #   tools/fuzz.sh --build                 only build the targets and the seeds
 #   tools/fuzz.sh --run SECONDS TARGET... fuzz without building (after --build; ctest's fuzz tier
 #                                         runs the targets side by side this way, tests/CMakeLists.txt)
@@ -48,14 +52,15 @@ usage() {
   exit 2
 }
 seconds=60
-targets=(fuzz_gltf fuzz_environment)
+all_targets=(fuzz_gltf fuzz_environment fuzz_draco fuzz_meshopt fuzz_webp)
+targets=("${all_targets[@]}")
 if ((run_step)); then
   seconds=${1:-60}
   if ! [[ $seconds =~ ^[0-9]+$ ]] || ((seconds == 0)); then usage; fi
   (($# > 1)) && targets=("${@:2}")
   ((build_step || $# > 1)) || usage
   for t in "${targets[@]}"; do
-    [[ $t == fuzz_gltf || $t == fuzz_environment ]] || usage
+    [[ " ${all_targets[*]} " == *" $t "* ]] || usage
   done
 elif (($# > 0)); then
   usage
@@ -72,6 +77,7 @@ if ((build_step)); then
   cmake --build "$build" -j"$jobs" >/dev/null
   rm -rf "$build/seeds"
   python3 tests/fuzz/make_seeds.py "$build/seeds" "$assets"
+  "$build/make_compressed_seeds" "$build/seeds" "$assets"
 fi
 ((run_step)) || exit 0
 for t in "${targets[@]}"; do
@@ -94,7 +100,9 @@ fuzz() {
   mkdir -p "$corpus" "$findings" "$build/logs"
   echo "wavepath fuzz: $target for ${seconds}s (log: $log)"
   local status=0
-  "$build/$target" "$corpus" "$build/seeds/$seeds" -dict="tests/fuzz/$dict" \
+  local dict_arg=()
+  [[ $dict != - ]] && dict_arg=(-dict="tests/fuzz/$dict")
+  "$build/$target" "$corpus" "$build/seeds/$seeds" "${dict_arg[@]}" \
     -max_len="$max_len" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -detect_leaks=1 -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1 ||
     status=$?
@@ -109,7 +117,9 @@ fuzz() {
 }
 
 # Each target's seed folder, dictionary and largest input.
-declare -A spec=([fuzz_gltf]="gltf gltf.dict 65536" [fuzz_environment]="environment environment.dict 16384")
+# The codecs' targets take no dictionary (their inputs are binary payloads).
+declare -A spec=([fuzz_gltf]="gltf gltf.dict 65536" [fuzz_environment]="environment environment.dict 16384"
+  [fuzz_draco]="draco - 65536" [fuzz_meshopt]="meshopt - 65536" [fuzz_webp]="webp - 65536")
 failed=0
 for t in "${targets[@]}"; do
   # shellcheck disable=SC2086 # the spec is three words

@@ -25,17 +25,14 @@ const std::vector<KnownExtension>& known_extensions() {
         {"EXT_lights_image_based", false, "the image-based light is not used (give --env)"},
         {"EXT_mesh_gpu_instancing", true,
          "every instance placed, each a copy of the mesh's triangles (no two-level BVH yet)"},
-        {"EXT_meshopt_compression", false,
-         "compressed buffer views are not decoded: their fallback buffers are read"},
+        {"EXT_meshopt_compression", true,
+         "buffer views decoded with meshoptimizer (all modes and filters)"},
         {"EXT_texture_avif", false,
          "AVIF images are not decoded: a texture's PNG or JPEG source is used, one without is "
          "skipped"},
-        {"EXT_texture_webp", false,
-         "WebP images are not decoded: a texture's PNG or JPEG source is used, one without is "
-         "skipped"},
+        {"EXT_texture_webp", true, "WebP images decoded with libwebp"},
         {"KHR_animation_pointer", false, "animations are not played: the scene at rest"},
-        {"KHR_draco_mesh_compression", false,
-         "Draco data is not decoded: the primitives' uncompressed accessors are read"},
+        {"KHR_draco_mesh_compression", true, "Draco meshes decoded with Draco"},
         {"KHR_lights_punctual", true, "point, spot and directional lights"},
         {"KHR_materials_anisotropy", true, "anisotropic GGX in the mesh's tangent frame"},
         {"KHR_materials_clearcoat", true, "a GGX dielectric coat with its own normal texture"},
@@ -54,9 +51,9 @@ const std::vector<KnownExtension>& known_extensions() {
         {"KHR_materials_volume", true,
          "refraction into volumes and absorption; thicknessTexture is not read"},
         {"KHR_mesh_quantization", true, "integer vertex attributes"},
-        {"KHR_texture_basisu", false,
-         "KTX2 images are not decoded: textures without a PNG or "
-         "JPEG source are skipped"},
+        {"KHR_texture_basisu", true,
+         "KTX2 images are not decoded (no decoder in Debian): each texture's fallback source is "
+         "used; a texture in use without one is an error"},
         {"KHR_texture_transform", true, "offset, rotation, scale and texCoord"},
         {"KHR_xmp_json_ld", false, "metadata, not needed to render"},
     };

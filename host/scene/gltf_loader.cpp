@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -23,8 +24,11 @@
 #include "host/util/files.h"
 #include "host/util/fnv1a.h"
 #include "host/scene/gltf_accessor.h"
+#include "host/scene/gltf_draco.h"
 #include "host/scene/gltf_extensions.h"
 #include "host/scene/gltf_material.h"
+#include "host/scene/gltf_meshopt.h"
+#include "host/scene/gltf_prepass.h"
 #include "host/scene/gltf_nodes.h"
 #include "host/scene/gltf_primitive.h"
 #include "host/scene/gltf_textures.h"
@@ -145,11 +149,32 @@ void check_json_depth(const unsigned char* text, std::size_t size) {
   }
 }
 
+// A .glb like `glb` (checked by check_glb, `length` bytes) with its JSON chunk replaced by `json`.
+std::vector<unsigned char> replace_glb_json(const std::vector<unsigned char>& glb,
+                                            std::size_t length, std::string json) {
+  while (json.size() % 4) json += ' ';
+  std::uint32_t old_json = 0;
+  std::memcpy(&old_json, &glb[12], 4);
+  const std::size_t rest = 20 + std::size_t{old_json};  // the BIN chunk, if any, from here
+  const std::uint64_t total = 20 + json.size() + (length - rest);
+  if (total > kMaxFileBytes) throw Error("the .glb grows past 4 GiB");
+  std::uint32_t header[5] = {0, 2, static_cast<std::uint32_t>(total),
+                             static_cast<std::uint32_t>(json.size()), 0x4E4F534Au};
+  std::memcpy(&header[0], "glTF", 4);
+  std::vector<unsigned char> out(static_cast<std::size_t>(total));
+  std::memcpy(out.data(), header, sizeof header);
+  std::memcpy(out.data() + sizeof header, json.data(), json.size());
+  std::memcpy(out.data() + sizeof header + json.size(), glb.data() + rest, length - rest);
+  return out;
+}
+
 // Parses the file with tinygltf (.glb when it starts with the binary magic, else JSON text);
-// tinygltf's warnings go to `warnings`, one line each; the file's FNV-1a digest to `digest`.
+// tinygltf's warnings go to `warnings`, one line each; the file's FNV-1a digest to `digest`; the
+// buffers EXT_meshopt_compression leaves without data to `placeholders` (what tinygltf cannot
+// parse in compressed files is rewritten first: gltf_prepass.h).
 tinygltf::Model parse(const std::string& path, std::vector<std::string>* warnings,
-                      std::uint64_t* digest) {
-  const std::vector<unsigned char> bytes = read_file(path);
+                      std::uint64_t* digest, gltf::PlaceholderBuffers* placeholders) {
+  std::vector<unsigned char> bytes = read_file(path);
   *digest = fnv1a64(bytes.data(), bytes.size());
   const bool glb = has_glb_magic(bytes);
   const std::string ext = std::filesystem::path(path).extension().string();
@@ -165,17 +190,29 @@ tinygltf::Model parse(const std::string& path, std::vector<std::string>* warning
   bool ok = false;
   try {
     if (glb) {
-      const std::size_t length = check_glb(bytes);
+      std::size_t length = check_glb(bytes);
       std::uint32_t json_length = 0;  // check_glb has checked that the chunk lies in the file
       std::memcpy(&json_length, &bytes[12], 4);
       check_json_depth(bytes.data() + 20, json_length);
+      std::string json(reinterpret_cast<const char*>(bytes.data()) + 20, json_length);
+      if (gltf::prepare_compressed_json(json, true, placeholders)) {
+        bytes = replace_glb_json(bytes, length, std::move(json));
+        length = bytes.size();
+      }
       ok = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                        static_cast<unsigned int>(length), base);
     } else {
       check_json_depth(bytes.data(), bytes.size());
-      ok = loader.LoadASCIIFromString(&model, &err, &warn,
-                                      reinterpret_cast<const char*>(bytes.data()),
-                                      static_cast<unsigned int>(bytes.size()), base);
+      // A copy of the text only for a file that may use the compression extensions.
+      std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+      std::string json;
+      if (gltf::mentions_compression(text.data(), text.size())) {
+        json.assign(text);
+        if (gltf::prepare_compressed_json(json, false, placeholders)) text = json;
+      }
+      if (text.size() > kMaxFileBytes) throw Error("the file grows past 4 GiB");
+      ok = loader.LoadASCIIFromString(&model, &err, &warn, text.data(),
+                                      static_cast<unsigned int>(text.size()), base);
     }
   } catch (const Error& e) {
     throw Error(path + ": " + e.what());
@@ -542,7 +579,8 @@ void compute_bounds(Scene& scene) {
 Scene load_gltf(const std::string& path, const LoadOptions& options) {
   Scene scene;
   scene.source = path;
-  const tinygltf::Model model = parse(path, &scene.warnings, &scene.digest);
+  gltf::PlaceholderBuffers placeholders;
+  tinygltf::Model model = parse(path, &scene.warnings, &scene.digest, &placeholders);
   // The files the glTF file names (a GLB's own binary chunk is in its digest already).
   for (const tinygltf::Buffer& b : model.buffers)
     if (!b.uri.empty()) scene.digest = fnv1a64(b.data.data(), b.data.size(), scene.digest);
@@ -562,6 +600,9 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
       throw Error("asset.version \"" + model.asset.version.substr(0, 32) +
                   "\" is not 2.x (only glTF 2.0 is supported)");
     if (model.scenes.empty()) throw Error("the file has no scenes");
+    // Compressed data first: everything below reads the decoded bytes as uncompressed ones.
+    gltf::decode_meshopt(model, placeholders);
+    gltf::decode_draco(model);
     const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (static_cast<std::size_t>(scene_index) >= model.scenes.size())
       throw Error("default scene " + std::to_string(scene_index) + " does not exist");

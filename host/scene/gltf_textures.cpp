@@ -1,5 +1,6 @@
 #include "host/scene/gltf_textures.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdio>
@@ -7,12 +8,15 @@
 #include <string>
 
 #include <stb_image.h>
+#include <webp/decode.h>
 
+#include "host/scene/gltf_json.h"
 #include "host/util/error.h"
 
 namespace wp::gltf {
 namespace {
 
+constexpr std::uint64_t kNoSource = ~std::uint64_t{0};
 constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648, kNearest = 9728,
               kLinear = 9729;  // magnification filters, and minification without mip-maps
 
@@ -111,6 +115,110 @@ void check_png_chunks(const unsigned char* bytes, std::size_t size, const std::s
   }
 }
 
+// At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before any decoder allocates them.
+void check_texels(int width, int height, const std::string& what) {
+  if (double(width) * double(height) > double(1u << 28))
+    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
+                " pixels, more than the 16384 x 16384 a texture may have");
+}
+
+bool is_webp(const unsigned char* bytes, std::size_t size) {
+  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
+}
+
+// A WebP image (EXT_texture_webp) as RGBA8: its header read and its size checked before the
+// texels are allocated, then decoded into them. An animation is refused (a texture is one image).
+void decode_webp(const unsigned char* bytes, std::size_t size, const std::string& what,
+                 Image& out) {
+  int width = 0, height = 0;
+  if (!WebPGetInfo(bytes, size, &width, &height))
+    throw Error(what + ": not a WebP image libwebp can read (bad or truncated header)");
+  WebPBitstreamFeatures features;
+  if (WebPGetFeatures(bytes, size, &features) != VP8_STATUS_OK)
+    throw Error(what + ": not a WebP image libwebp can read (bad or truncated header)");
+  if (features.has_animation)
+    throw Error(what + ": an animated WebP image (a texture is one still image)");
+  if (width <= 0 || height <= 0)
+    throw Error(what + ": WebP image of " + std::to_string(width) + " x " + std::to_string(height) +
+                " pixels");
+  check_texels(width, height, what);
+  const std::size_t row = 4 * std::size_t(width);
+  out.rgba.assign(row * std::size_t(height), 0);
+  if (!WebPDecodeRGBAInto(bytes, size, out.rgba.data(), out.rgba.size(), static_cast<int>(row)))
+    throw Error(what + ": cannot decode the WebP data (corrupt or truncated)");
+  out.width = width;
+  out.height = height;
+}
+
+// A JPEG's Huffman tables (DHT segments), walked before stb_image sees the file: each table may
+// have at most 256 codes. Debian's stb_image (2.27) copies a table's code sizes into a 257-byte
+// array and its values into a 256-byte one without checking the 16 counts' sum, up to 4,080
+// (fuzz_webp: a 40-byte JPEG wrote past both, UBSan). The walk follows the marker segments by
+// their lengths and, after a scan's header, skips entropy-coded bytes to the next marker, as
+// stb_image does; counts past the end of the file read as 0, as stb_image reads them. Not a JPEG:
+// nothing to check.
+void check_jpeg_tables(const unsigned char* bytes, std::size_t size, const std::string& what) {
+  if (size < 2 || bytes[0] != 0xff || bytes[1] != 0xd8) return;
+  const auto byte = [&](std::size_t at) -> std::size_t { return at < size ? bytes[at] : 0; };
+  std::size_t at = 2;
+  while (at + 1 < size) {
+    const std::size_t marker = bytes[at + 1];
+    if (bytes[at] != 0xff || marker == 0xff) {  // entropy-coded data, or a fill byte
+      ++at;
+      continue;
+    }
+    if (marker == 0xd9) break;  // end of image
+    // Markers without a segment: stuffed zero, TEM, SOI, RST0-7.
+    if (marker == 0x00 || marker == 0x01 || marker == 0xd8 || (marker >= 0xd0 && marker <= 0xd7)) {
+      at += 2;
+      continue;
+    }
+    const std::size_t length = byte(at + 2) << 8 | byte(at + 3);
+    if (marker == 0xc4) {
+      for (std::size_t table = at + 4; table < at + 2 + length;) {
+        std::size_t codes = 0;
+        for (std::size_t i = 1; i <= 16; ++i) codes += byte(table + i);
+        if (codes > 256)
+          throw Error(what + ": JPEG Huffman table at byte " + std::to_string(table) + " has " +
+                      std::to_string(codes) + " codes (at most 256)");
+        table += 17 + codes;
+      }
+    }
+    at += 2 + std::max<std::size_t>(length, 2);
+  }
+}
+
+bool is_png_or_jpeg(const unsigned char* bytes, std::size_t size) {
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return (size >= 8 && std::memcmp(bytes, kPng, 8) == 0) ||
+         (size >= 3 && bytes[0] == 0xff && bytes[1] == 0xd8 && bytes[2] == 0xff);
+}
+
+// A PNG or JPEG as RGBA8. Only those two: stb_image would take anything else as one of its other
+// formats, TGA among them, whose header has no signature (fuzzing: 18 bytes read as a 4608 x 47698
+// TGA made it allocate 880 MB and fill it for seconds).
+void decode_stb(const unsigned char* bytes, std::size_t size, const std::string& what, Image& out) {
+  if (!is_png_or_jpeg(bytes, size))
+    throw Error(what +
+                ": not a PNG, JPEG or WebP image (the formats glTF and EXT_texture_webp "
+                "allow)");
+  check_png_chunks(bytes, size, what);
+  check_jpeg_tables(bytes, size, what);
+  int width = 0, height = 0, channels = 0;
+  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels))
+    check_texels(width, height, what);
+  unsigned char* pixels =
+      stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    throw Error(what + ": cannot decode: " + (reason ? reason : "unknown format"));
+  }
+  out.width = width;
+  out.height = height;
+  out.rgba.assign(pixels, pixels + std::size_t(4) * std::size_t(width) * std::size_t(height));
+  stbi_image_free(pixels);
+}
+
 }  // namespace
 
 bool keep_encoded_image(tinygltf::Image* image, int, std::string*, std::string*, int, int,
@@ -184,12 +292,24 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
            " is not supported (only 0 and 1); texture ignored");
     return false;
   }
-  if (texture.source < 0) {  // e.g. only an extension's source (KTX2, WebP)
-    if (warn_unusable) warn(tex_where + " has no PNG or JPEG source; ignored");
+  // EXT_texture_webp's source is the image to use; `source` is a fallback for viewers without it.
+  // KHR_texture_basisu's KTX2 images have no decoder here (none in Debian): its fallback `source`
+  // is used, and a texture in use without one is an error naming the extension.
+  std::uint64_t source = texture.source < 0 ? kNoSource : std::uint64_t(texture.source);
+  if (const tinygltf::Value* webp =
+          extension_object(texture.extensions, "EXT_texture_webp", tex_where))
+    source = count_member(*webp, "source", tex_where + ": EXT_texture_webp", true);
+  if (source == kNoSource) {  // e.g. only an extension's source (KTX2, AVIF)
+    if (!warn_unusable) return false;
+    if (texture.extensions.count("KHR_texture_basisu"))
+      throw Error(tex_where +
+                  ": KHR_texture_basisu (KTX2) images cannot be decoded and the "
+                  "texture has no fallback source");
+    warn(tex_where + " has no PNG, JPEG or WebP source; ignored");
     return false;
   }
-  if (static_cast<std::size_t>(texture.source) >= model_.images.size())
-    throw Error(tex_where + ": image " + std::to_string(texture.source) + " does not exist");
+  if (source >= model_.images.size())
+    throw Error(tex_where + ": image " + std::to_string(source) + " does not exist");
   if (texture.sampler >= 0) {
     if (static_cast<std::size_t>(texture.sampler) >= model_.samplers.size())
       throw Error(tex_where + ": sampler " + std::to_string(texture.sampler) + " does not exist");
@@ -209,7 +329,7 @@ bool TextureTable::describe(const TextureInfo& info, bool srgb, const std::strin
   }
   ref.srgb = srgb;
   ref.texcoord = texcoord;
-  ref.image = texture.source;
+  ref.image = static_cast<int>(source);
   return true;
 }
 
@@ -254,25 +374,12 @@ int TextureTable::image(int index) {
   }
   if (size == 0) throw Error(what + ": no image data (file missing or unreadable?)");
   if (size > static_cast<std::size_t>(INT_MAX)) throw Error(what + ": larger than 2 GiB");
-  check_png_chunks(bytes, size, what);
-  int width = 0, height = 0, channels = 0;
-  // At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before stb_image allocates them.
-  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels) &&
-      double(width) * double(height) > double(1u << 28))
-    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
-                " pixels, more than the 16384 x 16384 a texture may have");
-  unsigned char* pixels =
-      stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
-  if (!pixels) {
-    const char* reason = stbi_failure_reason();
-    throw Error(what + ": cannot decode: " + (reason ? reason : "unknown format"));
-  }
   Image out;
+  if (is_webp(bytes, size))
+    decode_webp(bytes, size, what, out);
+  else
+    decode_stb(bytes, size, what, out);
   out.name = in.name.empty() ? in.uri.substr(0, 64) : in.name;
-  out.width = width;
-  out.height = height;
-  out.rgba.assign(pixels, pixels + std::size_t(4) * std::size_t(width) * std::size_t(height));
-  stbi_image_free(pixels);
   slot = static_cast<int>(scene_.images.size());
   scene_.images.push_back(std::move(out));
   return slot;

@@ -43,15 +43,15 @@ TEST(GltfExtensions, ReadmeTableIsTheTable) {
 }
 
 TEST(GltfExtensions, Statuses) {
-  const std::vector<wp::ExtensionUse> uses = wp::extension_uses(
-      {"KHR_materials_clearcoat", "EXT_lights_image_based", "KHR_draco_mesh_compression",
-       "VENDOR_unknown", "KHR_materials_clearcoat"},
-      {"KHR_materials_clearcoat", "KHR_draco_mesh_compression", "VENDOR_required_only"});
+  const std::vector<wp::ExtensionUse> uses =
+      wp::extension_uses({"KHR_materials_clearcoat", "EXT_lights_image_based", "EXT_texture_avif",
+                          "VENDOR_unknown", "KHR_materials_clearcoat"},
+                         {"KHR_materials_clearcoat", "EXT_texture_avif", "VENDOR_required_only"});
   ASSERT_EQ(uses.size(), 5u);  // each once, used first, then the rest of required
   const std::vector<std::pair<std::string, ExtensionSupport>> expected = {
       {"KHR_materials_clearcoat", ExtensionSupport::kSupported},
       {"EXT_lights_image_based", ExtensionSupport::kIgnored},
-      {"KHR_draco_mesh_compression", ExtensionSupport::kRefused},
+      {"EXT_texture_avif", ExtensionSupport::kRefused},
       {"VENDOR_unknown", ExtensionSupport::kIgnored},
       {"VENDOR_required_only", ExtensionSupport::kRefused}};
   for (std::size_t i = 0; i < expected.size(); ++i) {

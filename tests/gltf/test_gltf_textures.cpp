@@ -102,7 +102,7 @@ TEST(GltfLoader, TextureErrorsNameTheElement) {
   expect_error(with("[{\"source\":0}]", base0,
                     R"("images":[{"name":"junk","uri":"data:image/png;base64,AAAAAAAA"}])")
                    .write("t5.gltf"),
-               "image 0 'junk': cannot decode");
+               "image 0 'junk': not a PNG, JPEG or WebP image");
   expect_error(
       with("[{\"source\":0}]", base0, R"("images":[{"uri":"nowhere.png"}])").write("t6.gltf"),
       "image 0 (nowhere.png): no image data");
