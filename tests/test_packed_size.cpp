@@ -139,6 +139,52 @@ TEST(PackedSize, LayoutAgreesWithPackScene) {
   }
 }
 
+// The optional per-vertex arrays a program reads follow its features (kernels/material.h and
+// alpha.h read them only under these flags): texture coordinates for textures, tangents for normal
+// maps, colours for COLOR_0 and for alpha; none for a plain scene; all with every feature.
+TEST(PackedSize, OnlyTheVertexArraysTheProgramReadsArePacked) {
+  const auto packed = [](const Scene& s) {
+    const VertexArrays a = VertexArrays::of(SceneFeatures::of(s, false));
+    return std::string(a.tangents ? "t" : "") + (a.uvs ? "u" : "") + (a.colors ? "c" : "");
+  };
+  Scene s = small_scene(10);  // a base-colour texture
+  EXPECT_EQ(packed(s), "u");
+  s.materials[0].normal_texture = 0;
+  EXPECT_EQ(packed(s), "tu");
+  s.materials[0].alpha_mode = AlphaMode::kMask;
+  EXPECT_EQ(packed(s), "tuc");
+  s.materials[0] = test::diffuse_material({0.5f, 0.5f, 0.5f});
+  EXPECT_EQ(packed(s), "");
+  s.color0[3] = glm::vec4(0.5f, 1.0f, 1.0f, 1.0f);  // COLOR_0
+  EXPECT_EQ(packed(s), "c");
+  const VertexArrays all = VertexArrays::of(SceneFeatures::all());
+  EXPECT_TRUE(all.tangents && all.uvs && all.colors);
+
+  // An array left out is empty in both the layout up front and pack_scene's buffers.
+  const Scene t = small_scene(300);
+  const bvh::Bvh b = build_bvh(t, 8);
+  const LightTable lights =
+      build_light_table(t, nullptr, glm::vec3(0.0f), 1.0f, LightSelect::kPower);
+  const std::uint64_t vertex_bytes = t.positions.size() * sizeof(dev::float4);
+  for (const VertexArrays arrays :
+       {VertexArrays{}, VertexArrays{false, false, false}, VertexArrays{true, false, true}}) {
+    SceneExtras x;
+    x.lights = &lights;
+    x.vertex_arrays = arrays;
+    SceneCounts c = scene_counts(t, nullptr);
+    c.lights = lights.lights.size();
+    c.vertex_arrays = arrays;
+    const SceneLayout layout = scene_layout(c, bvh_bytes(b), kSceneBufferReach);
+    const PackedScene p = pack_scene(t, b, x);
+    ASSERT_EQ(p.buffers.size(), 1u);
+    EXPECT_EQ(layout.buffer_bytes.at(0), p.buffers[0].size());
+    ASSERT_STREQ(scene_array_name(5), "tangent");  // 5, 6, 7: kArrayNames' order
+    EXPECT_EQ(layout.sizes.at(5), arrays.tangents ? vertex_bytes : 0u);
+    EXPECT_EQ(layout.sizes.at(6), arrays.uvs ? vertex_bytes : 0u);
+    EXPECT_EQ(layout.sizes.at(7), arrays.colors ? vertex_bytes : 0u);
+  }
+}
+
 // Each array starts on a 64-byte boundary, never crosses the end of a buffer, and starts a new
 // buffer only when it would cross; the buffer map holds each array's buffer; refusals name the
 // cause.

@@ -93,6 +93,7 @@ SceneInfo scene_info(const Scene& scene, const InfoOptions& options) {
   info.state = state_memory(info.settings, info.features);
 
   SceneCounts counts = scene_counts(scene, nullptr, info.features.texture_lod);
+  counts.vertex_arrays = VertexArrays::of(info.features);
   counts.lights = lights.lights.size();
   std::vector<std::uint32_t> flags;
   const bvh::BuildInput input = bvh_input(scene, flags);

@@ -244,7 +244,8 @@ DeviceMaterials device_materials(const Scene& scene, bool mipmaps) {
 }
 
 // The per-triangle and per-vertex arrays, in kArrayNames' order from tri_vertices on.
-void add_geometry_arrays(const Scene& scene, dev::SceneDesc& d, std::vector<SceneArray>& arrays) {
+void add_geometry_arrays(const Scene& scene, const VertexArrays& packed, dev::SceneDesc& d,
+                         std::vector<SceneArray>& arrays) {
   const std::size_t tris = scene.triangle_count(), verts = scene.positions.size();
   arrays.push_back(convert_array(tris, d.tri_vertices, [&](std::size_t i) {
     return dev::uint4{scene.indices[3 * i], scene.indices[3 * i + 1], scene.indices[3 * i + 2],
@@ -254,15 +255,15 @@ void add_geometry_arrays(const Scene& scene, dev::SceneDesc& d, std::vector<Scen
       convert_array(verts, d.positions, [&](std::size_t i) { return f4(scene.positions[i]); }));
   arrays.push_back(
       convert_array(verts, d.normals, [&](std::size_t i) { return f4(scene.normals[i]); }));
-  arrays.push_back(convert_array(verts, d.tangents, [&](std::size_t i) {
+  arrays.push_back(convert_array(packed.tangents ? verts : 0, d.tangents, [&](std::size_t i) {
     return i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
   }));
-  arrays.push_back(convert_array(verts, d.uvs, [&](std::size_t i) {
+  arrays.push_back(convert_array(packed.uvs ? verts : 0, d.uvs, [&](std::size_t i) {
     const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
     const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
     return dev::float4{uv0.x, uv0.y, uv1.x, uv1.y};
   }));
-  arrays.push_back(convert_array(verts, d.colors, [&](std::size_t i) {
+  arrays.push_back(convert_array(packed.colors ? verts : 0, d.colors, [&](std::size_t i) {
     return i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
   }));
 }
@@ -276,7 +277,7 @@ std::vector<SceneArray> scene_arrays(const Scene& scene, const bvh::Bvh& bvh, co
                                   : copy_array(bvh.nodes, d.bvh_nodes));
   arrays.push_back(bvh.width == 8 ? copy_array(bvh.blocks, d.isect_tris)
                                   : copy_array(bvh.triangles, d.isect_tris));
-  add_geometry_arrays(scene, d, arrays);
+  add_geometry_arrays(scene, x.vertex_arrays, d, arrays);
   arrays.push_back(copy_array(m.materials, d.materials));
   arrays.push_back(copy_array(m.textures, d.textures));
   arrays.push_back(copy_array(m.images, d.images));
@@ -433,15 +434,16 @@ BvhBytes min_bvh_bytes(std::uint64_t triangles, int width) {
 
 SceneLayout scene_layout(const SceneCounts& c, const BvhBytes& bvh, std::uint64_t max_buffer) {
   if (c.texels > 0xffffffffu) throw Error(too_many_texels());
+  const auto optional = [&](bool packed) { return packed ? c.vertices * sizeof(dev::float4) : 0; };
   // pack_scene's arrays in its order.
   std::vector<std::uint64_t> sizes = {bvh.nodes,
                                       bvh.primitives,
                                       c.triangles * sizeof(dev::uint4),  // tri_vertices
                                       c.vertices * sizeof(dev::float4),  // positions
                                       c.vertices * sizeof(dev::float4),  // normals
-                                      c.vertices * sizeof(dev::float4),  // tangents
-                                      c.vertices * sizeof(dev::float4),  // uvs
-                                      c.vertices * sizeof(dev::float4),  // colors
+                                      optional(c.vertex_arrays.tangents),
+                                      optional(c.vertex_arrays.uvs),
+                                      optional(c.vertex_arrays.colors),
                                       c.materials * sizeof(dev::Material),
                                       c.textures * sizeof(dev::TextureRef),
                                       c.images * sizeof(dev::TextureImage),

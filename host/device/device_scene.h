@@ -13,6 +13,7 @@
 
 #include "bvh/bvh.h"
 #include "host/lights/environment.h"
+#include "host/device/scene_features.h"
 #include "host/lights/light_table.h"
 #include "host/scene/scene.h"
 #include "kernels/shared/types.h"
@@ -59,6 +60,16 @@ inline constexpr std::uint64_t kSceneBufferReach = std::uint64_t(1) << 38;
 dev::Camera device_camera(const Camera& camera, int width, int height);
 
 // Everything about the render that is not in Scene: the camera, what escaped rays see, the lights.
+// Which of the optional per-vertex arrays (tangents, texture coordinates, colours) are packed:
+// each costs 16 bytes a vertex, as much as the positions.
+struct VertexArrays {
+  bool tangents = true, uvs = true, colors = true;
+  // Those a program of `features` reads.
+  static VertexArrays of(const SceneFeatures& f) {
+    return {f.reads_tangents(), f.reads_uvs(), f.reads_colors()};
+  }
+};
+
 struct SceneExtras {
   dev::Camera camera{};
   glm::vec3 background{0.0f};           // constant radiance without a map
@@ -69,6 +80,8 @@ struct SceneExtras {
   // Mip chains after the images that textures minify through mip-maps (host/scene/mipmap.h), for
   // programs with WP_FEATURE_TEXTURE_LOD; without them every image has one level.
   bool mipmaps = false;
+  // The per-vertex arrays the program reads (SceneFeatures::reads_*); one it does not is empty.
+  VertexArrays vertex_arrays;
 };
 
 // Packs the scene into buffers of at most `max_buffer` bytes (the device's CL_DEVICE_MAX_MEM_ALLOC
@@ -113,6 +126,7 @@ struct SceneCounts {
   // size (LightTable::lights) makes the layout exact.
   std::uint64_t lights = 0;
   std::uint64_t env_texels = 0, env_marginal = 0, env_conditional = 0;  // no map: 0
+  VertexArrays vertex_arrays;  // those packed, as SceneExtras::vertex_arrays
 };
 // env may be null; `mipmaps` counts the mip chains pack_scene adds with SceneExtras::mipmaps.
 SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mipmaps = false);

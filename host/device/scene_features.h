@@ -38,6 +38,17 @@ struct SceneFeatures {
   bool dispersion = true;            // dispersion > 0 on a transmissive material with a volume
 
   static SceneFeatures all() { return {}; }
+
+  // Which per-vertex arrays beyond positions and normals the program reads (kernels/material.h,
+  // alpha.h): tangents for a tangent frame; texture coordinates for textures and wherever the
+  // layered BSDF's texture_point runs; colours for COLOR_0 and for alpha (its alpha channel). An
+  // array the program cannot read is packed empty.
+  bool reads_tangents() const { return normal_maps || anisotropy || clearcoat; }
+  bool reads_uvs() const {
+    return textures || normal_maps || texture_lod || specular || clearcoat || sheen || anisotropy ||
+           iridescence || diffuse_transmission || dispersion;
+  }
+  bool reads_colors() const { return vertex_colors || alpha; }
   // The features `scene` uses; `has_environment_map` tells whether the render has a map.
   static SceneFeatures of(const Scene& scene, bool has_environment_map);
 

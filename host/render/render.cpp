@@ -206,8 +206,9 @@ bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings&
                    const RenderOptions& options, const bvh::BuildOptions& bvh_options,
                    bool* cached) {
   std::vector<std::uint32_t> flags;
-  const SceneCounts counts =
-      scene_counts(scene, settings.environment.get(), render_features(scene, settings).texture_lod);
+  const SceneFeatures features = render_features(scene, settings);
+  SceneCounts counts = scene_counts(scene, settings.environment.get(), features.texture_lod);
+  counts.vertex_arrays = VertexArrays::of(features);
   const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
   check_scene_memory(
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)

@@ -140,6 +140,7 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
   extras.env_rotation_degrees = settings_.env_rotation;
   extras.lights = &lights_;
   extras.mipmaps = features_.texture_lod;
+  extras.vertex_arrays = VertexArrays::of(features_);
   // On a CPU device the kernels read the packed scene in place, which therefore stays here; a GPU
   // gets its own copy, and the host's goes at the end of this function.
   const bool in_place = !rt_.device().gpu;
