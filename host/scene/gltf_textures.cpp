@@ -188,6 +188,22 @@ void check_jpeg_tables(const unsigned char* bytes, std::size_t size, const std::
   }
 }
 
+// A JPEG's size against its bytes, before stb_image allocates the pixels (a 613-byte JPEG
+// claiming 16000 x 16000 pixels made it allocate 1 GiB and spend 2 s). Every 8 x 8 block of
+// every component is coded: a baseline scan spends at least 2 bits on a block (a DC difference
+// and an end-of-block code, each at least 1 bit), so at most 256 pixels a byte of luma; a
+// progressive file's first DC scan at least 1 bit (512 pixels a byte). More than 1024 pixels a
+// byte, past the first 2^16, cannot be a whole image. Not a JPEG: nothing to check.
+void check_jpeg_size(const unsigned char* bytes, std::size_t size, int width, int height,
+                     const std::string& what) {
+  if (size < 2 || bytes[0] != 0xff || bytes[1] != 0xd8) return;
+  const double pixels = double(width) * double(height);
+  if (pixels > 1024.0 * double(size) + 65536.0)
+    throw Error(what + ": JPEG data of " + std::to_string(size) + " bytes cannot hold its " +
+                std::to_string(width) + " x " + std::to_string(height) +
+                " pixels (at most 1024 a byte)");
+}
+
 bool is_png_or_jpeg(const unsigned char* bytes, std::size_t size) {
   static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   return (size >= 8 && std::memcmp(bytes, kPng, 8) == 0) ||
@@ -205,8 +221,10 @@ void decode_stb(const unsigned char* bytes, std::size_t size, const std::string&
   check_png_chunks(bytes, size, what);
   check_jpeg_tables(bytes, size, what);
   int width = 0, height = 0, channels = 0;
-  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels))
+  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels)) {
     check_texels(width, height, what);
+    check_jpeg_size(bytes, size, width, height, what);
+  }
   unsigned char* pixels =
       stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
   if (!pixels) {

@@ -308,6 +308,19 @@ inline std::vector<unsigned char> encode_png(int w, int h, const std::vector<uns
   return png;
 }
 
+inline std::vector<unsigned char> encode_jpeg(int w, int h,
+                                              const std::vector<unsigned char>& rgba) {
+  std::vector<unsigned char> jpeg;
+  stbi_write_jpg_to_func(
+      [](void* out, void* data, int size) {
+        auto* v = static_cast<std::vector<unsigned char>*>(out);
+        v->insert(v->end(), static_cast<unsigned char*>(data),
+                  static_cast<unsigned char*>(data) + size);
+      },
+      &jpeg, w, h, 4, rgba.data(), 90);
+  return jpeg;
+}
+
 inline std::string png_data_uri(int w, int h, const std::vector<unsigned char>& rgba) {
   return "data:image/png;base64," + base64(encode_png(w, h, rgba));
 }

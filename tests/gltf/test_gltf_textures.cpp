@@ -118,6 +118,26 @@ TEST(GltfLoader, TextureErrorsNameTheElement) {
                "image 0: PNG chunk at byte 33 claims 1869730601 bytes, more than the file has");
   expect_error(with("[{\"source\":0}]", base0, patched_png(16, 60000)).write("t9.gltf"),
                "bytes cannot hold its");
+  // A JPEG whose frame header claims 16000 x 16000 pixels in a few hundred bytes is refused
+  // before stb_image allocates them (1 GiB); the same file at its own 2 x 2 loads.
+  const auto patched_jpeg = [](int w, int h) {
+    std::vector<unsigned char> jpeg = encode_jpeg(2, 2, kImage0);
+    for (std::size_t i = 2; i + 8 < jpeg.size(); ++i)
+      if (jpeg[i] == 0xff && jpeg[i + 1] == 0xc0) {  // SOF0: length, precision, height, width
+        jpeg[i + 5] = static_cast<unsigned char>(h >> 8),
+                 jpeg[i + 6] = static_cast<unsigned char>(h);
+        jpeg[i + 7] = static_cast<unsigned char>(w >> 8),
+                 jpeg[i + 8] = static_cast<unsigned char>(w);
+        break;
+      }
+    return R"("images":[{"uri":"data:image/jpeg;base64,)" + base64(jpeg) + R"("}])";
+  };
+  expect_error(with("[{\"source\":0}]", base0, patched_jpeg(16000, 16000)).write("t11.gltf"),
+               "cannot hold its 16000 x 16000 pixels");
+  EXPECT_EQ(wp::load_gltf(with("[{\"source\":0}]", base0, patched_jpeg(2, 2)).write("t12.gltf"))
+                .images.at(0)
+                .width,
+            2);
   expect_error(with("[{\"source\":0}]", R"({"normalTexture":{"index":0,"extensions":{)"
                                         R"("KHR_texture_transform":{"offset":[1]}}}})")
                    .write("t7.gltf"),
