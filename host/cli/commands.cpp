@@ -216,6 +216,8 @@ std::pair<std::string, std::string> describe(const std::exception_ptr& error) {
     return {e.what(), e.details()};
   } catch (const cl::Error& e) {
     return {std::string("OpenCL: ") + e.what() + " failed with " + wp::cl_error_name(e.err()), ""};
+  } catch (const std::bad_alloc&) {
+    return {"out of memory (an allocation failed)", ""};
   } catch (const std::exception& e) {
     return {e.what(), ""};
   } catch (...) {

@@ -111,7 +111,9 @@ int info_command(const InfoOptions& options) {
   validate(size);  // --width and --height as render checks them
   std::optional<Scene> scene;
   try {
-    scene = load_gltf(options.scene, LoadOptions{options.variant});
+    LoadOptions load(options.variant);
+    load.check_counts = check_host_counts;  // a scene the host cannot load is refused first
+    scene = load_gltf(options.scene, load);
   } catch (const RefusedExtensions& e) {
     std::cout << (options.json ? refused_json(options.scene, e.what(), e.uses())
                                : refused_text(options.scene, e.uses()))

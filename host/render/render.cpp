@@ -139,11 +139,31 @@ void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uin
                 gb(available) + " are available");
 }
 
+namespace {
+
+// The start of check_scene_counts' and check_host_counts' errors.
+std::string too_large(const LoadCounts& counts) {
+  return "scene too large: its " + std::to_string(counts.triangles) + " triangles (" +
+         std::to_string(counts.placements) + " mesh placements, each a copy of its mesh) ";
+}
+
+// The loader's bytes for `triangles`: three indices and a material each.
+std::uint64_t loading_bytes(std::uint64_t triangles) {
+  return triangles * (3 * sizeof(std::uint32_t) + sizeof(std::uint32_t));
+}
+
+}  // namespace
+
+void check_host_counts(const LoadCounts& counts) {
+  const std::uint64_t loading = loading_bytes(counts.triangles), available = available_memory();
+  if (available && loading > available)
+    throw Error(too_large(counts) + "need at least " + gb(loading) + " of memory to load, " +
+                gb(available) + " are available");
+}
+
 void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
                         const RenderSettings& settings) {
-  const std::string what = "scene too large: its " + std::to_string(counts.triangles) +
-                           " triangles (" + std::to_string(counts.placements) +
-                           " mesh placements, each a copy of its mesh) ";
+  const std::string what = too_large(counts);
   SceneCounts least;
   least.triangles = counts.triangles;
   std::uint64_t packed = 0;
@@ -154,16 +174,12 @@ void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
   } catch (const Error& e) {  // an array larger than a buffer, or more than the buffers
     throw Error(what + "cannot be packed: " + e.what());
   }
-  const std::uint64_t loading =
-      counts.triangles * (3 * sizeof(std::uint32_t) + sizeof(std::uint32_t));
-  const std::uint64_t available = available_memory();
+  const std::uint64_t loading = loading_bytes(counts.triangles), available = available_memory();
   if (device.gpu) {
     if (device.global_memory && packed > device.global_memory)
       throw Error(what + "pack into at least " + gb(packed) + ", " + device.name + " has " +
                   gb(device.global_memory));
-    if (available && loading > available)
-      throw Error(what + "need at least " + gb(loading) + " of host memory to load, " +
-                  gb(available) + " are available");
+    check_host_counts(counts);
     return;
   }
   if (available && packed + loading > available)

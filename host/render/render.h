@@ -141,6 +141,9 @@ void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uin
 // alone instead of growing until the system kills the process.
 void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
                         const RenderSettings& settings);
+// The host part alone (for `wavepath info`, which packs nothing): the loader's 16 bytes a
+// triangle against the memory available.
+void check_host_counts(const LoadCounts& counts);
 
 // Fails (wp::Error naming the image size, the bytes needed and the device's limit) when the
 // buffers of `memory` cannot be allocated on `device`: one larger than CL_DEVICE_MAX_MEM_ALLOC_SIZE
