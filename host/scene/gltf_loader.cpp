@@ -319,6 +319,7 @@ class SceneBuilder {
   template <class Visit>
   void walk(int scene_index, Visit&& visit) const;
   void count_mesh(int mesh, std::uint64_t copies, LoadCounts& counts) const;
+  bool any_attribute(const char* name) const;
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
   void count_placement(const tinygltf::Node& node);
@@ -332,7 +333,7 @@ class SceneBuilder {
   Scene& scene_;
   int variant_;
   std::optional<std::uint32_t> default_material_;
-  gltf::VertexNeeds file_needs_;  // uv1 and tangents: whether the scene keeps them at all
+  gltf::VertexNeeds file_needs_;  // the optional arrays: whether the scene keeps them at all
   std::set<std::pair<int, std::size_t>> warned_;  // (mesh, primitive): instances warn once
   std::set<int> placed_;                          // the meshes nodes place (GltfSummary)
 };
@@ -388,6 +389,14 @@ void SceneBuilder::count_mesh(int mesh, std::uint64_t copies, LoadCounts& counts
   }
 }
 
+// Whether some primitive of the file has attribute `name`.
+bool SceneBuilder::any_attribute(const char* name) const {
+  for (const tinygltf::Mesh& mesh : model_.meshes)
+    for (const tinygltf::Primitive& p : mesh.primitives)
+      if (p.attributes.count(name)) return true;
+  return false;
+}
+
 LoadCounts SceneBuilder::count(int scene_index) const {
   LoadCounts counts;
   walk(scene_index, [&](int node, const glm::dmat4&) {
@@ -400,6 +409,10 @@ LoadCounts SceneBuilder::count(int scene_index) const {
 void SceneBuilder::build(int scene_index, const LoadCounts& counts) {
   for (const TextureRef& t : scene_.textures) file_needs_.uv1 |= t.texcoord == 1;
   for (const Material& m : scene_.materials) file_needs_.tangents |= needs_tangents(m);
+  // TEXCOORD_0 and COLOR_0 only where the file has them (8 and 16 bytes a vertex); TEXCOORD_0
+  // also for tangents, which are generated from it.
+  file_needs_.uv0 = file_needs_.tangents || any_attribute("TEXCOORD_0");
+  file_needs_.color0 = any_attribute("COLOR_0");
   // At most max_triangles, each counted from bytes in the file; vertices are counted per
   // primitive as it is loaded (gltf_primitive.cpp).
   scene_.indices.reserve(3 * counts.max_triangles);

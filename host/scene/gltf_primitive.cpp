@@ -123,6 +123,8 @@ class VertexSource {
         world_(world),
         normal_matrix_(normal_matrix(world)),
         mirror_(glm::determinant(glm::dmat3(world)) < 0.0),
+        uv0_needed_(needs.uv0),
+        color0_needed_(needs.color0),
         uv1_needed_(needs.uv1),
         tangents_needed_(needs.tangents) {
     if (uv1_needed_) uv1_ = open_attribute(model, p, "TEXCOORD_1", kTexcoord1, pos.count());
@@ -156,12 +158,16 @@ class VertexSource {
   std::uint32_t push(Scene& s, std::uint32_t i, const glm::vec3& p, const glm::vec3& n) const {
     s.positions.push_back(p);
     s.normals.push_back(n);
-    glm::vec2 uv(0.0f);
-    if (uv_) uv_->read(i, glm::value_ptr(uv));
-    s.uv0.push_back(uv);
-    float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // vec3 colours are opaque
-    if (color_) color_->read(i, f);
-    s.color0.push_back(color_ ? glm::vec4(f[0], f[1], f[2], f[3]) : glm::vec4(1.0f));
+    if (uv0_needed_) {
+      glm::vec2 uv(0.0f);
+      if (uv_) uv_->read(i, glm::value_ptr(uv));
+      s.uv0.push_back(uv);
+    }
+    if (color0_needed_) {
+      float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // vec3 colours are opaque
+      if (color_) color_->read(i, f);
+      s.color0.push_back(color_ ? glm::vec4(f[0], f[1], f[2], f[3]) : glm::vec4(1.0f));
+    }
     if (uv1_needed_) {
       glm::vec2 uv1(0.0f);
       if (uv1_) uv1_->read(i, glm::value_ptr(uv1));
@@ -182,7 +188,7 @@ class VertexSource {
   glm::dmat4 world_;
   glm::dmat3 normal_matrix_;
   bool mirror_;
-  bool uv1_needed_, tangents_needed_;
+  bool uv0_needed_, color0_needed_, uv1_needed_, tangents_needed_;
 };
 
 // Makes room for `extra` more vertices in every per-vertex array the scene keeps. A vector that
@@ -194,10 +200,10 @@ void reserve_vertices(Scene& s, std::size_t extra) {
   const std::size_t capacity = std::max(need, s.positions.size() + s.positions.size() / 4);
   s.positions.reserve(capacity);
   s.normals.reserve(capacity);
-  s.uv0.reserve(capacity);
-  s.color0.reserve(capacity);
-  if (!s.uv1.empty() || s.uv1.capacity()) s.uv1.reserve(capacity);
-  if (!s.tangents.empty() || s.tangents.capacity()) s.tangents.reserve(capacity);
+  for (auto* kept : {&s.uv0, &s.uv1})  // the optional arrays the scene keeps (VertexNeeds)
+    if (kept->capacity()) kept->reserve(capacity);
+  for (auto* kept : {&s.color0, &s.tangents})
+    if (kept->capacity()) kept->reserve(capacity);
 }
 
 // What a triangle's three corners get: their shared vertices where all three have normals,
@@ -233,8 +239,15 @@ void emit(const VertexSource& v, std::size_t vertex_count, const std::vector<std
   }
   if (s.positions.size() + added >= kUnused)
     throw Error("more vertices than 32-bit indices can address");
-  if (needs.uv1 && s.uv1.empty()) s.uv1.reserve(s.positions.capacity());
-  if (needs.tangents && s.tangents.empty()) s.tangents.reserve(s.positions.capacity());
+  // A kept optional array has capacity from the first primitive on: reserve_vertices grows it.
+  const auto keep = [&](bool needed, auto& array) {
+    if (needed && array.capacity() == 0)
+      array.reserve(std::max<std::size_t>(s.positions.capacity(), 1));
+  };
+  keep(needs.uv0, s.uv0);
+  keep(needs.color0, s.color0);
+  keep(needs.uv1, s.uv1);
+  keep(needs.tangents, s.tangents);
   reserve_vertices(s, added);
   std::fill(scene_index.begin(), scene_index.end(), kUnused);
   const auto shared = [&](std::uint32_t c) {
@@ -305,8 +318,8 @@ std::uint32_t duplicate_vertex(Scene& s, std::uint32_t i) {
   reserve_vertices(s, 1);
   s.positions.push_back(s.positions[i]);
   s.normals.push_back(s.normals[i]);
-  s.uv0.push_back(s.uv0[i]);
-  s.color0.push_back(s.color0[i]);
+  if (!s.uv0.empty()) s.uv0.push_back(s.uv0[i]);
+  if (!s.color0.empty()) s.color0.push_back(s.color0[i]);
   if (!s.uv1.empty()) s.uv1.push_back(s.uv1[i]);
   s.tangents.push_back(s.tangents[i]);
   return static_cast<std::uint32_t>(s.positions.size() - 1);

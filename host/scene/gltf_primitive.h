@@ -12,9 +12,11 @@
 namespace wp::gltf {
 
 // What the scene keeps per vertex beyond position, normal, TEXCOORD_0 and COLOR_0. The loader
-// decides once per file, so that Scene::uv1 and Scene::tangents are either empty or as long as
-// Scene::positions.
+// decides once per file, so that Scene::uv0, color0, uv1 and tangents are each either empty or as
+// long as Scene::positions.
 struct VertexNeeds {
+  bool uv0 = true;        // keep TEXCOORD_0 (some primitive has it, or tangents are kept); (0, 0)
+  bool color0 = true;     // keep COLOR_0 (some primitive has it); (1, 1, 1, 1) where absent
   bool uv1 = false;       // keep TEXCOORD_1 (some texture reads it); (0, 0) where absent
   bool tangents = false;  // keep tangents (some material needs a tangent frame: gltf_loader.cpp)
   // The TEXCOORD set this primitive's normal texture reads (else its clearcoat normal or

@@ -186,11 +186,13 @@ struct Scene {
   std::string variant;
 
   // Vertices (world space). normals are unit; uv0 is TEXCOORD_0 or (0,0); color0 is COLOR_0 as
-  // linear RGBA or (1,1,1,1).
+  // linear RGBA or (1,1,1,1). uv0, uv1, color0 and tangents are each either as long as positions
+  // or empty, which reads as their default everywhere (the loader keeps uv0 and color0 only for
+  // files that have the attribute, uv1 and tangents only where a material needs them).
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uv0;
-  std::vector<glm::vec2> uv1;  // TEXCOORD_1 or (0,0); may be empty when no material uses it
+  std::vector<glm::vec2> uv1;  // TEXCOORD_1 or (0,0)
   std::vector<glm::vec4> color0;
   std::vector<glm::vec4> tangents;  // xyz unit, w handedness; supplied or generated; may be empty
 

@@ -34,9 +34,9 @@ void check_texture_slot(int slot, std::size_t textures, std::size_t material, co
 void check_scene(const wp::Scene& s) {
   const std::size_t v = s.positions.size();
   check_same_size(s.normals.size(), v, "normals", false);
-  check_same_size(s.uv0.size(), v, "uv0", false);
+  check_same_size(s.uv0.size(), v, "uv0", true);
   check_same_size(s.uv1.size(), v, "uv1", true);
-  check_same_size(s.color0.size(), v, "color0", false);
+  check_same_size(s.color0.size(), v, "color0", true);
   check_same_size(s.tangents.size(), v, "tangents", true);
   if (s.indices.size() % 3 != 0) invariant_failed("indices is not a multiple of 3");
   if (s.triangle_material.size() != s.triangle_count())

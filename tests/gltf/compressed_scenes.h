@@ -44,7 +44,9 @@ inline std::vector<Triangle> triangles(const Scene& s) {
   for (std::size_t t = 0; t < out.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = s.indices[3 * t + std::size_t(k)];
-      out[t][std::size_t(k)] = {s.positions[v], s.normals[v], s.uv0[v]};
+      // (0, 0) where the scene keeps no TEXCOORD_0 (scene.h)
+      out[t][std::size_t(k)] = {s.positions[v], s.normals[v],
+                                v < s.uv0.size() ? s.uv0[v] : glm::vec2(0.0f)};
     }
   return out;
 }

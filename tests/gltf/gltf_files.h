@@ -201,8 +201,8 @@ inline void check_invariants(const wp::Scene& s) {
   ASSERT_EQ(s.indices.size() % 3, 0u);
   ASSERT_EQ(s.triangle_material.size(), s.triangle_count());
   ASSERT_EQ(s.normals.size(), s.positions.size());
-  ASSERT_EQ(s.uv0.size(), s.positions.size());
-  ASSERT_EQ(s.color0.size(), s.positions.size());
+  ASSERT_TRUE(s.uv0.empty() || s.uv0.size() == s.positions.size());        // empty: all (0, 0)
+  ASSERT_TRUE(s.color0.empty() || s.color0.size() == s.positions.size());  // empty: all 1
   ASSERT_FALSE(s.materials.empty());
   for (const std::uint32_t i : s.indices) ASSERT_LT(i, s.positions.size());
   for (const std::uint32_t m : s.triangle_material) ASSERT_LT(m, s.materials.size());
