@@ -206,8 +206,8 @@ void reserve_vertices(Scene& s, std::size_t extra) {
     if (kept->capacity()) kept->reserve(capacity);
 }
 
-// What a triangle's three corners get: their shared vertices where all three have normals,
-// unshared ones carrying the face normal otherwise.
+// A vertex's normal as emit() has found it: not looked at yet, usable, or missing (absent, zero
+// or not finite after the transform).
 enum : std::uint8_t { kNormalUnknown = 0, kNormalUsable = 1, kNormalMissing = 2 };
 
 // Appends triangles over the primitive's vertex indices `tris`: shared vertices where all three
