@@ -15,21 +15,6 @@ namespace {
 // bounded by any buffer, so cap it to keep a malformed count from allocating without limit.
 constexpr std::size_t kMaxCountWithoutData = std::size_t{1} << 26;
 
-int component_count(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return 1;
-    case TINYGLTF_TYPE_VEC2:
-      return 2;
-    case TINYGLTF_TYPE_VEC3:
-      return 3;
-    case TINYGLTF_TYPE_VEC4:
-      return 4;
-    default:
-      return 0;  // matrices and unknown types
-  }
-}
-
 int component_size(int component_type) {
   switch (component_type) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
@@ -126,6 +111,21 @@ std::size_t span_bytes(std::size_t count, std::size_t stride, std::size_t elemen
 }
 
 }  // namespace
+
+int component_count(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    default:
+      return 0;  // matrices and unknown types
+  }
+}
 
 std::size_t readable_count(const tinygltf::Model& model, int accessor) {
   if (accessor < 0 || static_cast<std::size_t>(accessor) >= model.accessors.size()) return 0;

@@ -24,6 +24,9 @@ constexpr unsigned kIndexBits = component_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_B
                                 component_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) |
                                 component_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
 
+// Components of an accessor `type` (SCALAR 1, VECn n); 0 for matrices and unknown types.
+int component_count(int type);
+
 // What a caller accepts from an accessor.
 struct AccessorSpec {
   const char* what;    // role named in messages: "POSITION", "indices", ...

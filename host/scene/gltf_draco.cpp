@@ -8,6 +8,7 @@
 #include <draco/compression/decode.h>
 #include <draco/mesh/mesh.h>
 
+#include "host/scene/gltf_accessor.h"
 #include "host/scene/gltf_json.h"
 #include "host/util/error.h"
 
@@ -37,14 +38,6 @@ int gltf_component_type(draco::DataType type) {
     default:
       return 0;
   }
-}
-
-int type_components(int type) {
-  return type == TINYGLTF_TYPE_SCALAR ? 1
-         : type == TINYGLTF_TYPE_VEC2 ? 2
-         : type == TINYGLTF_TYPE_VEC3 ? 3
-         : type == TINYGLTF_TYPE_VEC4 ? 4
-                                      : 0;
 }
 
 // Draco's messages as one line.
@@ -214,9 +207,9 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const tiny
       throw Error(at + ": accessor " + std::to_string(attribute->second) + " count " +
                   std::to_string(a.count) + " differs from the decoded " +
                   std::to_string(mesh.points) + " points");
-    if (type_components(a.type) != data.components)
+    if (component_count(a.type) != data.components)
       throw Error(at + ": accessor " + std::to_string(attribute->second) + " has " +
-                  std::to_string(type_components(a.type)) + " components, the Draco attribute " +
+                  std::to_string(component_count(a.type)) + " components, the Draco attribute " +
                   std::to_string(data.components));
     writer.assign(attribute->second, source + "attribute " + std::to_string(id),
                   data.component_type, a.normalized, mesh.points, data.bytes, at);

@@ -322,7 +322,7 @@ class SceneBuilder {
   bool any_attribute(const char* name) const;
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
-  void count_placement(const tinygltf::Node& node);
+  void count_placement(int mesh, const std::vector<glm::dmat4>* instances);
   std::uint32_t material_index(int material);
   int primitive_material(const tinygltf::Primitive& p) const;
   gltf::VertexNeeds vertex_needs(std::uint32_t material) const;
@@ -431,11 +431,12 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
   const std::string where = "node " + std::to_string(node_index) + ": ";
   try {
     if (node.mesh >= 0) {
-      if (const auto instances = gltf::instance_transforms(model_, node, node_index))
+      const auto instances = gltf::instance_transforms(model_, node, node_index);
+      if (instances)
         for (const glm::dmat4& instance : *instances) add_mesh(node.mesh, world * instance);
       else
         add_mesh(node.mesh, world);
-      count_placement(node);
+      count_placement(node.mesh, instances ? &*instances : nullptr);
     }
     if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
     const int light = gltf::node_light(node, node_index);
@@ -481,24 +482,16 @@ void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
   }
 }
 
-// GltfSummary's counts for a node that places a mesh: its EXT_mesh_gpu_instancing instances from
-// the first attribute's accessor (instance_transforms has checked them all).
-void SceneBuilder::count_placement(const tinygltf::Node& node) {
+// GltfSummary's counts for a node that places mesh `mesh`, with its EXT_mesh_gpu_instancing
+// instances (null: the node has none).
+void SceneBuilder::count_placement(int mesh, const std::vector<glm::dmat4>* instances) {
   GltfSummary& summary = scene_.gltf;
   ++summary.mesh_nodes;
-  placed_.insert(node.mesh);
+  placed_.insert(mesh);
   summary.meshes_placed = placed_.size();
-  const auto it = node.extensions.find("EXT_mesh_gpu_instancing");
-  if (it == node.extensions.end()) return;
+  if (!instances) return;
   ++summary.gpu_instanced_nodes;
-  const tinygltf::Value& ext = it->second;
-  if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject()) return;
-  const tinygltf::Value& attributes = ext.Get("attributes");
-  const std::vector<std::string> keys = attributes.Keys();
-  if (keys.empty() || !attributes.Get(keys.front()).IsInt()) return;
-  const int accessor = attributes.Get(keys.front()).GetNumberAsInt();
-  if (accessor >= 0 && static_cast<std::size_t>(accessor) < model_.accessors.size())
-    summary.gpu_instances += model_.accessors[static_cast<std::size_t>(accessor)].count;
+  summary.gpu_instances += instances->size();
 }
 
 // Materials keep their glTF indices; glTF's default material follows them, added on first use.

@@ -49,13 +49,15 @@ void orientation(const glm::dmat4& world, glm::vec3* forward, glm::vec3* up) {
 
 constexpr const char* kInstancing = "EXT_mesh_gpu_instancing";
 
-// The extension's attributes object of `node`, or null without the extension.
-const tinygltf::Value* instancing_attributes(const tinygltf::Node& node, const std::string& where) {
+// The extension's attributes object of `node`: null without the extension (*present false) or
+// when it has no such object (*present true).
+const tinygltf::Value* instancing_attributes(const tinygltf::Node& node, bool* present) {
   const auto it = node.extensions.find(kInstancing);
-  if (it == node.extensions.end()) return nullptr;
+  *present = it != node.extensions.end();
+  if (!*present) return nullptr;
   const tinygltf::Value& ext = it->second;
   if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject())
-    throw Error(where + ": " + kInstancing + " has no attributes object");
+    return nullptr;
   return &ext.Get("attributes");
 }
 
@@ -64,8 +66,10 @@ const tinygltf::Value* instancing_attributes(const tinygltf::Node& node, const s
 std::optional<std::vector<glm::dmat4>> instance_transforms(const tinygltf::Model& model,
                                                            const tinygltf::Node& node, int index) {
   const std::string where = "node " + std::to_string(index) + ": " + kInstancing;
-  const tinygltf::Value* attributes = instancing_attributes(node, "node " + std::to_string(index));
-  if (!attributes) return std::nullopt;
+  bool present = false;
+  const tinygltf::Value* attributes = instancing_attributes(node, &present);
+  if (!present) return std::nullopt;
+  if (!attributes) throw Error(where + " has no attributes object");
   constexpr unsigned kSnorm =
       component_bit(TINYGLTF_COMPONENT_TYPE_BYTE) | component_bit(TINYGLTF_COMPONENT_TYPE_SHORT);
   const AccessorSpec kTranslation{"TRANSLATION", 3, 3, kFloatBit};
@@ -136,14 +140,12 @@ std::optional<std::vector<glm::dmat4>> instance_transforms(const tinygltf::Model
 }
 
 std::size_t placements(const tinygltf::Model& model, const tinygltf::Node& node) {
-  const auto it = node.extensions.find(kInstancing);
-  if (it == node.extensions.end()) return 1;
-  const tinygltf::Value& ext = it->second;
-  if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject()) return 0;
-  const tinygltf::Value& attributes = ext.Get("attributes");
-  for (const std::string& name : attributes.Keys())
-    if (attributes.Get(name).IsInt())
-      if (const std::size_t n = readable_count(model, attributes.Get(name).GetNumberAsInt()))
+  bool present = false;
+  const tinygltf::Value* attributes = instancing_attributes(node, &present);
+  if (!present) return 1;
+  for (const std::string& name : attributes ? attributes->Keys() : std::vector<std::string>{})
+    if (attributes->Get(name).IsInt())
+      if (const std::size_t n = readable_count(model, attributes->Get(name).GetNumberAsInt()))
         return n;
   return 0;
 }

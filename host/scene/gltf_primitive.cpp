@@ -121,8 +121,9 @@ class VertexSource {
         uv_(open_attribute(model, p, "TEXCOORD_0", kTexcoord, pos.count())),
         color_(open_attribute(model, p, "COLOR_0", kColor, pos.count())),
         world_(world),
+        linear_(world),
         normal_matrix_(normal_matrix(world)),
-        mirror_(glm::determinant(glm::dmat3(world)) < 0.0),
+        mirror_(glm::determinant(linear_) < 0.0),
         uv0_needed_(needs.uv0),
         color0_needed_(needs.color0),
         uv1_needed_(needs.uv1),
@@ -176,7 +177,7 @@ class VertexSource {
     if (tangents_needed_) {
       float t[4] = {0.0f, 0.0f, 0.0f, 1.0f};
       if (tangent_) tangent_->read(i, t);
-      s.tangents.push_back(tangent_ ? world_tangent(glm::dmat3(world_), mirror_, t)
+      s.tangents.push_back(tangent_ ? world_tangent(linear_, mirror_, t)
                                     : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
     }
     return static_cast<std::uint32_t>(s.positions.size() - 1);
@@ -186,6 +187,7 @@ class VertexSource {
   const AccessorReader& pos_;
   std::optional<AccessorReader> normal_, uv_, color_, uv1_, tangent_;
   glm::dmat4 world_;
+  glm::dmat3 linear_;  // world's 3x3: tangents
   glm::dmat3 normal_matrix_;
   bool mirror_;
   bool uv0_needed_, color0_needed_, uv1_needed_, tangents_needed_;

@@ -296,28 +296,22 @@ inline void check_indexed_quad(const char* name) {
 }
 
 // Textures (test_gltf_textures.cpp; tangents in test_gltf_primitive.cpp).
+// stb_image_write's callback appending to a std::vector<unsigned char>.
+inline void append_bytes(void* out, void* data, int size) {
+  auto* v = static_cast<std::vector<unsigned char>*>(out);
+  v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+}
+
 inline std::vector<unsigned char> encode_png(int w, int h, const std::vector<unsigned char>& rgba) {
   std::vector<unsigned char> png;
-  stbi_write_png_to_func(
-      [](void* out, void* data, int size) {
-        auto* v = static_cast<std::vector<unsigned char>*>(out);
-        v->insert(v->end(), static_cast<unsigned char*>(data),
-                  static_cast<unsigned char*>(data) + size);
-      },
-      &png, w, h, 4, rgba.data(), 4 * w);
+  stbi_write_png_to_func(append_bytes, &png, w, h, 4, rgba.data(), 4 * w);
   return png;
 }
 
 inline std::vector<unsigned char> encode_jpeg(int w, int h,
                                               const std::vector<unsigned char>& rgba) {
   std::vector<unsigned char> jpeg;
-  stbi_write_jpg_to_func(
-      [](void* out, void* data, int size) {
-        auto* v = static_cast<std::vector<unsigned char>*>(out);
-        v->insert(v->end(), static_cast<unsigned char*>(data),
-                  static_cast<unsigned char*>(data) + size);
-      },
-      &jpeg, w, h, 4, rgba.data(), 90);
+  stbi_write_jpg_to_func(append_bytes, &jpeg, w, h, 4, rgba.data(), 90);
   return jpeg;
 }
 
