@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "../kernels/shared/bvh_layout.h"
@@ -70,6 +71,10 @@ struct Bvh {
   std::vector<dev::TriBlock4> blocks;    // width 8: each leaf's triangles, 4 per block
   glm::vec3 lo{0.0f}, hi{0.0f};          // scene bounds
   BuildStats stats;
+  // A two-level BVH (build_two_level) has instances; the arrays above then hold the top-level
+  // tree and every mesh's tree (bvh_layout.h), and the top-level leaves reference instance_refs.
+  std::vector<dev::BvhInstance> instances;
+  std::vector<std::uint32_t> instance_refs;
 };
 
 // Builds the BVH. Throws bvh::Error on failure (e.g. bad options, Embree error). An input without
@@ -78,9 +83,29 @@ struct Bvh {
 // origin.
 Bvh build(const BuildInput& input, const BuildOptions& options = {});
 
+// One placement of a mesh in a two-level BVH.
+struct InstanceInput {
+  glm::dmat4 to_world;     // affine, invertible: object space to world space
+  std::uint32_t mesh = 0;  // index into build_two_level's meshes
+};
+
+// A two-level BVH: a top-level tree (built like the meshes' trees, one instance per leaf) over
+// the instances' world-space boxes (each mesh's box through its transform), followed by the
+// meshes' trees, merged into one Bvh of their layout (bvh_layout.h). meshes[i] is built over mesh
+// i's triangles alone (its triangle indices from 0); first_triangle[i] is added to them, giving
+// the scene's triangle indices. BvhInstance.meta.y is left WP_NO_LIGHT (the light table's to
+// fill). The stats add up those of the trees (sah_cost and max_depth: the top-level tree's).
+// Instances of a mesh without triangles are left out. Throws bvh::Error for a singular transform
+// or references past the layout's index range.
+Bvh build_two_level(std::vector<Bvh> meshes, const std::vector<std::uint32_t>& first_triangle,
+                    const std::vector<InstanceInput>& instances, const BuildOptions& options);
+
 // CPU reference traversal of the flattened layout (either width, by bvh.width), with the same
 // arithmetic as the kernels: the specification they copy (arithmetic: traverse_common.h; order:
 // bvh_traverse.cpp for width 2, bvh_traverse_wide.cpp for width 8).
+// A two-level BVH's reference traverses every instance in index order (the kernels follow the
+// top-level tree): the same closest t, the same instance and triangle unless two instances'
+// hits tie.
 struct Ray {
   glm::vec3 o;
   glm::vec3 d;
@@ -89,9 +114,14 @@ struct Ray {
 };
 struct Hit {
   bool hit = false;
-  float t = 0, u = 0, v = 0;   // barycentrics: p = (1-u-v) v0 + u v1 + v v2
-  std::uint32_t triangle = 0;  // scene triangle index
+  float t = 0, u = 0, v = 0;                // barycentrics: p = (1-u-v) v0 + u v1 + v v2
+  std::uint32_t triangle = 0;               // scene triangle index
+  std::uint32_t instance = WP_NO_INSTANCE;  // two-level BVHs: the instance hit
 };
+// The ray in an instance's object space, in the kernels' arithmetic (traverse.h, object_ray):
+// o' = to_object x o, d' = its 3x3 part x d, each row's products summed left to right, no fused
+// multiply-add.
+Ray object_ray(const dev::BvhInstance& instance, const Ray& ray);
 Hit intersect_closest(const Bvh& bvh, const Ray& ray);
 bool occluded(const Bvh& bvh, const Ray& ray);
 

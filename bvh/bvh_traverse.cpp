@@ -46,8 +46,12 @@ bool leaf_test(const Bvh& bvh, const PreparedRay& r, std::int32_t ref, std::int3
   return found;
 }
 
-// Closest hit (any = false) or any hit (any = true) within (ray.tmin, ray.tmax).
-Hit trace_binary(const Bvh& bvh, const Ray& ray, bool any) {
+}  // namespace
+
+namespace detail {
+
+// Closest hit (any = false) or any hit (any = true) within (ray.tmin, ray.tmax), from node `root`.
+Hit trace_binary(const Bvh& bvh, const Ray& ray, bool any, std::int32_t root) {
   Hit hit;
   if (bvh.nodes.empty()) return hit;
   const PreparedRay r(ray);
@@ -55,7 +59,7 @@ Hit trace_binary(const Bvh& bvh, const Ray& ray, bool any) {
   float tmax = ray.tmax;
   std::int32_t stack[WP_BVH_STACK_SIZE];
   int sp = 0;
-  std::int32_t node = 0;
+  std::int32_t node = root;
   for (;;) {
     const dev::BvhNode& n = bvh.nodes[static_cast<std::size_t>(node)];
     const dev::float4 a = n.c0_xy, b = n.c1_xy, z = n.c01_z;
@@ -87,16 +91,18 @@ Hit trace_binary(const Bvh& bvh, const Ray& ray, bool any) {
   return hit;
 }
 
-}  // namespace
+}  // namespace detail
 
 Hit intersect_closest(const Bvh& bvh, const Ray& ray) {
+  if (!bvh.instances.empty()) return detail::trace_instances(bvh, ray, false);
   return bvh.width == WP_BVH8_WIDTH ? detail::trace_wide(bvh, ray, false)
-                                    : trace_binary(bvh, ray, false);
+                                    : detail::trace_binary(bvh, ray, false);
 }
 
 bool occluded(const Bvh& bvh, const Ray& ray) {
+  if (!bvh.instances.empty()) return detail::trace_instances(bvh, ray, true).hit;
   return (bvh.width == WP_BVH8_WIDTH ? detail::trace_wide(bvh, ray, true)
-                                     : trace_binary(bvh, ray, true))
+                                     : detail::trace_binary(bvh, ray, true))
       .hit;
 }
 

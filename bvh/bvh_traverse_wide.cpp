@@ -96,14 +96,14 @@ void insert(Entry inner[8], int& count, Entry e) {
 
 }  // namespace
 
-Hit trace_wide(const Bvh& bvh, const Ray& ray, bool any) {
+Hit trace_wide(const Bvh& bvh, const Ray& ray, bool any, std::int32_t root) {
   Hit hit;
   if (bvh.nodes8.empty()) return hit;
   const PreparedRay r(ray);
   float tmax = ray.tmax;  // the current closest t
   Entry stack[WP_BVH8_STACK_SIZE];
   int sp = 0;
-  std::int32_t node = 0;
+  std::int32_t node = root;
   for (;;) {
     const dev::BvhNode8& n = bvh.nodes8[static_cast<std::size_t>(node)];
     float tnear[WP_BVH8_WIDTH];

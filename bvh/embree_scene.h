@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "bvh.h"
 
@@ -33,6 +34,34 @@ class EmbreeScene {
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+};
+
+// Embree's own two-level structure: a scene per mesh (the triangles [first, first + count) of
+// `indices`, mesh i being meshes[i]) and an instance geometry (RTC_GEOMETRY_TYPE_INSTANCE) per
+// instance, with its transform; the oracle and benchmark reference for build_two_level.
+class EmbreeInstances {
+ public:
+  struct MeshRange {
+    std::uint32_t first = 0, count = 0;
+  };
+  EmbreeInstances(const glm::vec3* positions, const std::uint32_t* indices,
+                  const std::vector<MeshRange>& meshes, const std::vector<InstanceInput>& instances,
+                  bool robust);
+  ~EmbreeInstances();
+  EmbreeInstances(const EmbreeInstances&) = delete;
+  EmbreeInstances& operator=(const EmbreeInstances&) = delete;
+
+  // Hit::triangle is the scene's triangle (first + Embree's primID), Hit::instance the index into
+  // `instances`.
+  Hit intersect(const Ray& ray) const;
+  bool occluded(const Ray& ray) const;
+  RTCScene handle() const { return scene_; }
+
+ private:
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  std::vector<RTCScene> meshes_;
+  std::vector<std::uint32_t> first_;  // per instance: its mesh's first triangle
 };
 
 }  // namespace wp::bvh

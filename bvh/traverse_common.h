@@ -136,6 +136,10 @@ inline bool triangle_test(const PreparedRay& r, const TriangleData& tri, float t
 
 // The width-8 traversal (bvh_traverse_wide.cpp): closest hit (any = false) or any hit within
 // (ray.tmin, ray.tmax).
-Hit trace_wide(const Bvh& bvh, const Ray& ray, bool any);
+Hit trace_wide(const Bvh& bvh, const Ray& ray, bool any, std::int32_t root = 0);
+Hit trace_binary(const Bvh& bvh, const Ray& ray, bool any, std::int32_t root = 0);
+// A two-level BVH (bvh_two_level.cpp): every instance in turn, each with the ray in its mesh's
+// space (object_ray), the closest hit over all of them.
+Hit trace_instances(const Bvh& bvh, const Ray& ray, bool any);
 
 }  // namespace wp::bvh::detail

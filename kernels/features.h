@@ -5,6 +5,9 @@
 #ifndef WP_FEATURES_H
 #define WP_FEATURES_H
 
+#ifndef WP_BVH_INSTANCES
+#define WP_BVH_INSTANCES 0 /* a two-level BVH (shared/bvh_layout.h): the scene's structure */
+#endif
 #ifndef WP_FEATURE_PUNCTUAL_LIGHTS
 #define WP_FEATURE_PUNCTUAL_LIGHTS 1 /* point, spot or directional lights */
 #endif
@@ -27,8 +30,9 @@
 #define WP_FEATURE_TEXTURES 1 /* any material texture */
 #endif
 #ifndef WP_FEATURE_TEXTURE_LOD
-#define WP_FEATURE_TEXTURE_LOD 1 /* mip-mapped textures looked up through ray cones (ray_cone.h) \
-                                  */
+#define WP_FEATURE_TEXTURE_LOD                                      \
+  1 /* mip-mapped textures looked up through ray cones (ray_cone.h) \
+     */
 #endif
 #ifndef WP_FEATURE_NORMAL_MAPS
 #define WP_FEATURE_NORMAL_MAPS 1 /* tangent-space normal textures */

@@ -88,15 +88,18 @@ static inline float triangle_solid_angle_pdf(float area, float dist, float cos_l
   return dist * dist / (area * fabs(cos_light));
 }
 
-static inline LightSample sample_triangle(const SceneView* scene, uint tri, float3 p, float2 u) {
+/* A point on triangle `tri` of instance `inst` (instance.h) for the shading point p. */
+static inline LightSample sample_triangle(const SceneView* scene, uint inst, uint tri, float3 p,
+                                          float2 u) {
   LightSample s;
   s.delta = false;
   s.pdf = 0.0f;
   s.li = (float3)(0.0f);
-  const uint4 tv = scene->tri_vertices[tri];
-  const float3 p0 = scene->positions[tv.x].xyz;
-  const float3 e1 = scene->positions[tv.y].xyz - p0;
-  const float3 e2 = scene->positions[tv.z].xyz - p0;
+  float no_u = 0.0f, no_v = 0.0f;
+  const uint4 tv = placed_triangle(scene, inst, tri, &no_u, &no_v);
+  const float3 p0 = placed_position(scene, inst, tv.x);
+  const float3 e1 = placed_position(scene, inst, tv.y) - p0;
+  const float3 e2 = placed_position(scene, inst, tv.z) - p0;
   /* Uniform over the area: b1 = 1 - sqrt(u1)... written as barycentrics of v1 and v2. */
   const float r = sqrt(u.x);
   const float b1 = r * (1.0f - u.y), b2 = r * u.y;
@@ -115,7 +118,9 @@ static inline LightSample sample_triangle(const SceneView* scene, uint tri, floa
   s.target = offset_origin(q, cos_light > 0.0f ? n / area2 : -n / area2, q_scale);
   s.li = material_emission(scene, tv, b1, b2);
 #if WP_FEATURE_ALPHA
-  s.li *= alpha_coverage(scene, tri, b1, b2); /* no light from a cut-out or see-through part */
+  /* No light from a cut-out or see-through part; alpha_coverage takes the file's winding. */
+  const bool mirrored = instance_mirrors(scene, inst);
+  s.li *= alpha_coverage(scene, tri, mirrored ? b2 : b1, mirrored ? b1 : b2);
 #endif
   return s;
 }
@@ -138,7 +143,7 @@ static inline LightSample sample_light(const SceneView* scene, float3 p, float u
   LightSample s;
   const uint type = light->meta.x;
   if (type == WP_LIGHT_TRIANGLE) {
-    s = sample_triangle(scene, light->meta.y, p, u);
+    s = sample_triangle(scene, light->meta.z, light->meta.y, p, u);
   } else if (type == WP_LIGHT_ENVIRONMENT) {
     s.li = env_sample(scene, u, &s.wi, &s.pdf);
     s.dist = INFINITY;
@@ -156,14 +161,17 @@ static inline LightSample sample_light(const SceneView* scene, float3 p, float u
 
 /* The pdf with which NEE would have produced the direction of a ray that hit emissive triangle
  * `tri` at distance dist with cos_light between ray and triangle normal. */
-static inline float triangle_light_pdf(const SceneView* scene, uint tri, float dist,
+static inline float triangle_light_pdf(const SceneView* scene, uint inst, uint tri, float dist,
                                        float cos_light) {
-  const uint li = scene->tri_light[tri];
+  uint li = scene->tri_light[tri];
   if (li == WP_NO_LIGHT) return 0.0f;
+#if WP_BVH_INSTANCES
+  li += scene->instances[inst].meta.y; /* the instance's first light (types.h, tri_light) */
+#endif
   const uint4 tv = scene->tri_vertices[tri];
-  const float3 p0 = scene->positions[tv.x].xyz;
-  const float area =
-      0.5f * length(cross(scene->positions[tv.y].xyz - p0, scene->positions[tv.z].xyz - p0));
+  const float3 p0 = placed_position(scene, inst, tv.x);
+  const float area = 0.5f * length(cross(placed_position(scene, inst, tv.y) - p0,
+                                         placed_position(scene, inst, tv.z) - p0));
   return scene->light_alias[li].pmf * triangle_solid_angle_pdf(area, dist, cos_light);
 }
 

@@ -10,6 +10,7 @@
 #define WP_MATERIAL_H
 
 #include "bsdf.h"
+#include "instance.h"
 #include "ray_cone.h"
 #include "scene.h"
 #include "textures.h" /* unconditionally: the source expander includes each header once */
@@ -43,9 +44,15 @@ static inline float3 material_emission(const SceneView* scene, uint4 tv, float u
  * n, the interpolated vertex normal on the front side) and bitangent cross(n, t) * w (glTF's
  * convention; w the handedness). Without a usable tangent any frame around n: a map's orientation
  * is lost there, not its tilt. */
-static inline void tangent_frame(const SceneView* scene, uint4 tv, float u, float v, float3 n,
-                                 float3* t, float3* b) {
+static inline void tangent_frame(const SceneView* scene, uint inst, uint4 tv, float u, float v,
+                                 float3 n, float3* t, float3* b) {
+#if WP_BVH_INSTANCES
+  const float4 t4 = (1.0f - u - v) * placed_tangent(scene, inst, tv.x) +
+                    u * placed_tangent(scene, inst, tv.y) + v * placed_tangent(scene, inst, tv.z);
+#else
+  (void)inst;
   const float4 t4 = interpolate4(scene->tangents, tv, u, v);
+#endif
   *t = t4.xyz - n * dot(n, t4.xyz);
   const float len = length(*t);
   if (len > 1e-6f) {
@@ -60,10 +67,10 @@ static inline void tangent_frame(const SceneView* scene, uint4 tv, float u, floa
 #if WP_FEATURE_NORMAL_MAPS || WP_FEATURE_CLEARCOAT
 /* The normal of normal texture `tex` at the point, in the front side's frame: the tangent-space
  * normal (texel * 2 - 1, x and y times `scale`) in the tangent frame around n. */
-static inline float3 normal_mapped(const SceneView* scene, int tex, float scale, uint4 tv, float u,
-                                   float v, TexPoint tp, float3 n) {
+static inline float3 normal_mapped(const SceneView* scene, int tex, float scale, uint inst,
+                                   uint4 tv, float u, float v, TexPoint tp, float3 n) {
   float3 t, b;
-  tangent_frame(scene, tv, u, v, n, &t, &b);
+  tangent_frame(scene, inst, tv, u, v, n, &t, &b);
   float3 c = texture_at(scene, tex, tp).xyz * 2.0f - 1.0f;
   c.xy *= scale;
   const float3 p = c.x * t + c.y * b + c.z * n;
@@ -140,10 +147,10 @@ static inline float4 texel_or_one(const SceneView* scene, int tex, TexPoint tp) 
  * to the side of wo like ns) and the anisotropy direction (the rotation and the texture's
  * direction in the tangent frame, made perpendicular to ns; a strength of 0 where no direction
  * is left). */
-static inline void resolve_extensions(const SceneView* scene, __global const Material* m, uint4 tv,
-                                      float u, float v, TexPoint tp, float3 n_front, float3 wo,
-                                      Surface* s) {
-  (void)scene, (void)tv, (void)u, (void)v, (void)tp, (void)n_front, (void)wo;
+static inline void resolve_extensions(const SceneView* scene, __global const Material* m, uint inst,
+                                      uint4 tv, float u, float v, TexPoint tp, float3 n_front,
+                                      float3 wo, Surface* s) {
+  (void)scene, (void)inst, (void)tv, (void)u, (void)v, (void)tp, (void)n_front, (void)wo;
 #if WP_FEATURE_SPECULAR
   s->specular *= texel_or_one(scene, m->textures1.y, tp).w;
   s->specular_color = m->specular.xyz * texel_or_one(scene, m->textures1.z, tp).xyz;
@@ -154,7 +161,8 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
   float3 nc = n_front;
 #if WP_FEATURE_TEXTURES
   const bool coat_mapped = m->textures2.y >= 0;
-  if (coat_mapped) nc = normal_mapped(scene, m->textures2.y, m->clearcoat.z, tv, u, v, tp, nc);
+  if (coat_mapped)
+    nc = normal_mapped(scene, m->textures2.y, m->clearcoat.z, inst, tv, u, v, tp, nc);
 #endif
   if (dot(nc, s->ng) < 0.0f) nc = -nc;
 #if WP_FEATURE_TEXTURES
@@ -181,7 +189,7 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
   s->anisotropy = 0.0f, s->aniso_t = (float3)(0.0f); /* no direction: isotropic */
   if (strength > 0.0f) {
     float3 t, b;
-    tangent_frame(scene, tv, u, v, n_front, &t, &b);
+    tangent_frame(scene, inst, tv, u, v, n_front, &t, &b);
     float3 d = dir.x * t + dir.y * b;
     d -= s->ns * dot(s->ns, d);
     const float len = length(d);
@@ -230,17 +238,18 @@ static inline TexPoint texture_point(const SceneView* scene, uint4 tv, float u, 
   return tp;
 }
 
-/* Geometry and material at a hit of a ray with direction ray_d on triangle tv at barycentrics
- * (u, v), reached by a ray cone `cone_width` across there (ray_cone.h; 0: full-resolution
- * textures). *front tells whether the ray hit the front (counter-clockwise) side; both normals are
- * turned to face the ray. */
-static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u, float v,
+/* Geometry and material at a hit of a ray with direction ray_d on triangle `tri` of instance
+ * `inst` (instance.h) at barycentrics (u, v), reached by a ray cone `cone_width` across there
+ * (ray_cone.h; 0: full-resolution textures). *front tells whether the ray hit the front
+ * (counter-clockwise) side; both normals are turned to face the ray. */
+static inline Surface resolve_surface(const SceneView* scene, uint inst, uint tri, float u, float v,
                                       float3 ray_d, float cone_width, bool* front) {
+  const uint4 tv = placed_triangle(scene, inst, tri, &u, &v);
   __global const Material* m = scene->materials + tv.w;
   Surface s;
-  const float3 p0 = scene->positions[tv.x].xyz;
-  const float3 p1 = scene->positions[tv.y].xyz;
-  const float3 p2 = scene->positions[tv.z].xyz;
+  const float3 p0 = placed_position(scene, inst, tv.x);
+  const float3 p1 = placed_position(scene, inst, tv.y);
+  const float3 p2 = placed_position(scene, inst, tv.z);
   s.p = (1.0f - u - v) * p0 + u * p1 + v * p2;
   s.p_scale = max3(fabs((1.0f - u - v) * p0) + fabs(u * p1) + fabs(v * p2));
   const float3 n = cross(p1 - p0, p2 - p0);
@@ -250,15 +259,22 @@ static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u,
   if (!*front) s.ng = -s.ng;
   const TexPoint tp = texture_point(scene, tv, u, v, cone_width, dot(s.ng, ray_d), len);
 #if WP_FEATURE_TEXTURE_LOD
-  s.curvature = triangle_curvature(p0, p1, p2, scene->normals[tv.x].xyz, scene->normals[tv.y].xyz,
-                                   scene->normals[tv.z].xyz);
+  s.curvature =
+      triangle_curvature(p0, p1, p2, placed_normal(scene, inst, tv.x),
+                         placed_normal(scene, inst, tv.y), placed_normal(scene, inst, tv.z));
   if (!*front) s.curvature = -s.curvature; /* the normals point to the front side */
 #endif
+#if WP_BVH_INSTANCES
+  const float3 n_front =
+      normalize((1.0f - u - v) * placed_normal(scene, inst, tv.x) +
+                u * placed_normal(scene, inst, tv.y) + v * placed_normal(scene, inst, tv.z));
+#else
   const float3 n_front = normalize(interpolate3(scene->normals, tv, u, v));
+#endif
   s.ns = n_front;
 #if WP_FEATURE_NORMAL_MAPS
   if (m->textures0.z >= 0)
-    s.ns = normal_mapped(scene, m->textures0.z, m->extra.x, tv, u, v, tp, n_front);
+    s.ns = normal_mapped(scene, m->textures0.z, m->extra.x, inst, tv, u, v, tp, n_front);
 #endif
   /* Computed on the front side's frame; turned, like the interpolated normal, to the side the
    * ray sees (for a back-side hit that mirrors the whole front-side frame). */
@@ -271,7 +287,7 @@ static inline Surface resolve_surface(const SceneView* scene, uint4 tv, float u,
   if (!(dot(s.ns, -ray_d) > 1e-4f)) s.ns = s.ng;
   resolve_material(scene, m, tv, u, v, tp, &s);
 #if WP_BSDF_EXTENSIONS
-  resolve_extensions(scene, m, tv, u, v, tp, n_front, -ray_d, &s);
+  resolve_extensions(scene, m, inst, tv, u, v, tp, n_front, -ray_d, &s);
 #endif
   s.flags = *front ? WP_SURF_FRONT : 0u;
 #if WP_FEATURE_UNLIT

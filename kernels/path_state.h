@@ -69,6 +69,24 @@ static inline Paths paths_bind(__global uchar* base, PathLayout layout) {
 #undef WP_PATH_LANE
 #undef WP_PATH_FIELD
 
+/* The hit's instance (shared/bvh_layout.h): WP_NO_INSTANCE, and nothing stored, without a
+ * two-level BVH. */
+static inline uint path_hit_instance(Paths paths, uint slot) {
+#if WP_BVH_INSTANCES
+  return paths.hit_instance[slot];
+#else
+  (void)paths, (void)slot;
+  return WP_NO_INSTANCE;
+#endif
+}
+static inline void path_set_hit_instance(Paths paths, uint slot, uint instance) {
+#if WP_BVH_INSTANCES
+  paths.hit_instance[slot] = instance;
+#else
+  (void)paths, (void)slot, (void)instance;
+#endif
+}
+
 /* The halves of the flags and bounce words (shared/path_state.def). The low halves hold the flags
  * and the bounce count (--max-depth stays below 2^16 - 1, so roulette's increment never carries
  * into the high half); the high halves hold the ray cone (ray_cone.h) as bfloat16, the upper 16

@@ -23,6 +23,10 @@ typedef struct SceneView {
   __global const float4* env_texels;
   __global const float* env_marginal;
   __global const float* env_conditional;
+#if WP_BVH_INSTANCES
+  __global const BvhInstance* instances;
+  __global const uint* instance_refs;
+#endif
   const SceneDesc* desc; /* counts, camera, background, environment parameters */
 } SceneView;
 
@@ -77,6 +81,10 @@ static inline SceneView scene_bind(__global const uchar* const* b, const SceneDe
   s.env_texels = WP_SCENE_ARRAY(float4, 15, env_texels);
   s.env_marginal = WP_SCENE_ARRAY(float, 16, env_marginal);
   s.env_conditional = WP_SCENE_ARRAY(float, 17, env_conditional);
+#if WP_BVH_INSTANCES
+  s.instances = WP_SCENE_ARRAY(BvhInstance, 18, instances);
+  s.instance_refs = WP_SCENE_ARRAY(uint, 19, instance_refs);
+#endif
   s.desc = d;
   return s;
 }

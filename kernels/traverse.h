@@ -28,11 +28,17 @@ typedef struct TraceRay {
   int kx, ky, kz;
   float sx, sy, sz;
   float o_kx, o_ky, o_kz;
+#if WP_BVH_INSTANCES
+  float dx, dy, dz; /* the direction, which a two-level BVH maps into each instance's space */
+#endif
 } TraceRay;
 
 typedef struct TraceHit {
   float t, u, v;
   uint tri; /* scene triangle index; valid when t < the ray's tmax */
+#if WP_BVH_INSTANCES
+  uint inst; /* its instance (shared/bvh_layout.h) */
+#endif
 } TraceHit;
 
 static inline float safe_rcp(float d) {
@@ -45,6 +51,9 @@ static inline TraceRay trace_ray(float3 o, float3 d, float tmin, uint alpha_key)
   r.ix = safe_rcp(d.x), r.iy = safe_rcp(d.y), r.iz = safe_rcp(d.z);
   r.tmin = tmin;
   r.alpha_key = alpha_key;
+#if WP_BVH_INSTANCES
+  r.dx = d.x, r.dy = d.y, r.dz = d.z;
+#endif
   const float ax = fabs(d.x), ay = fabs(d.y), az = fabs(d.z);
   const int kz = ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2);
   int kx = kz == 2 ? 0 : kz + 1;
@@ -130,49 +139,87 @@ static inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref,
 
 #if WP_BVH_WIDTH == 8
 #include "traverse8.h"
+#define WP_WALK_NAME mesh_walk
+#define WP_WALK_LEAF leaf8_test
+#include "traverse8_walk.def"
 #else
-/* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
- * hit; the hit record holds the closest one found. */
-static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
-                             bool any) {
-  __global const BvhNode* nodes = scene->nodes;
-  int stack[WP_BVH_STACK_SIZE];
-  int sp = 0;
-  int node = 0;
+#define WP_WALK_NAME mesh_walk
+#define WP_WALK_LEAF leaf_test
+#include "traverse_walk.def"
+#endif
+
+#if WP_BVH_INSTANCES
+/* A two-level BVH (shared/bvh_layout.h): the top-level tree's leaves are instances, each walked
+ * with the ray mapped into its mesh's space. The mapping's products are summed in the order of
+ * the CPU reference (bvh/bvh_two_level.cpp, object_ray); distances along the ray are the same in
+ * both spaces, so the hit record's t and the walk's bound carry across levels unchanged. */
+static inline TraceRay object_trace_ray(__global const BvhInstance* inst, const TraceRay* r) {
+  float o[3], d[3];
+  for (int i = 0; i < 3; ++i) {
+    const float4 m = inst->to_object[i];
+    o[i] = ((m.x * r->ox + m.y * r->oy) + m.z * r->oz) + m.w;
+    d[i] = (m.x * r->dx + m.y * r->dy) + m.z * r->dz;
+  }
+  return trace_ray((float3)(o[0], o[1], o[2]), (float3)(d[0], d[1], d[2]), r->tmin, r->alpha_key);
+}
+
+/* Instance `k`'s mesh against the world ray r; on a closer hit records the instance too. */
+static inline bool instance_test(const SceneView* scene, const TraceRay* r, uint k, TraceHit* hit,
+                                 bool any) {
+  __global const BvhInstance* inst = scene->instances + k;
+  const TraceRay o = object_trace_ray(inst, r);
+  if (!mesh_walk(scene, &o, (int)inst->meta.x, hit, any)) return false;
+  hit->inst = k;
+  return true;
+}
+
+/* The instances refs[0, n), unused references (WP_NO_INSTANCE) skipped. */
+static inline bool instances_test(const SceneView* scene, const TraceRay* r,
+                                  __global const uint* refs, int n, TraceHit* hit, bool any) {
   bool found = false;
-  hit->t = tmax;
-  for (;;) {
-    __global const BvhNode* n = nodes + node;
-    const float4 a = n->c0_xy, b = n->c1_xy, z = n->c01_z;
-    const int4 link = n->link;
-    float t0 = box_entry(r, a.x, a.y, a.z, a.w, z.x, z.y, hit->t);
-    float t1 = box_entry(r, b.x, b.y, b.z, b.w, z.z, z.w, hit->t);
-    if (t0 < INFINITY && link.x < 0) {
-      found |= leaf_test(scene, r, link.x, link.z, hit, any);
-      if (found && any) return true;
-      t0 = INFINITY;
-    }
-    if (t1 < INFINITY && link.y < 0) {
-      found |= leaf_test(scene, r, link.y, link.w, hit, any);
-      if (found && any) return true;
-      t1 = INFINITY;
-    }
-    if (t0 < INFINITY && t1 < INFINITY) {
-      const bool first0 = t0 <= t1;
-      stack[sp++] = first0 ? link.y : link.x;
-      node = first0 ? link.x : link.y;
-    } else if (t0 < INFINITY) {
-      node = link.x;
-    } else if (t1 < INFINITY) {
-      node = link.y;
-    } else {
-      if (sp == 0) break;
-      node = stack[--sp];
+  for (int i = 0; i < n; ++i) {
+    if (refs[i] == WP_NO_INSTANCE) continue;
+    if (instance_test(scene, r, refs[i], hit, any)) {
+      found = true;
+      if (any) return true;
     }
   }
   return found;
 }
 
-#endif /* WP_BVH_WIDTH */
+#if WP_BVH_WIDTH == 8
+/* A top-level leaf ~ref: 4 instance references per block (bvh_layout.h). */
+static inline bool instance_leaf8(const SceneView* scene, const TraceRay* r, int ref, TraceHit* hit,
+                                  bool any) {
+  const int c = ~ref;
+  return instances_test(scene, r, scene->instance_refs + 4 * (c >> 2), 4 * ((c & 3) + 1), hit, any);
+}
+#define WP_WALK_NAME top_walk
+#define WP_WALK_LEAF instance_leaf8
+#include "traverse8_walk.def"
+#else
+/* A top-level leaf: `count` instance references from ~ref. */
+static inline bool instance_leaf(const SceneView* scene, const TraceRay* r, int ref, int count,
+                                 TraceHit* hit, bool any) {
+  return instances_test(scene, r, scene->instance_refs + ~ref, count, hit, any);
+}
+#define WP_WALK_NAME top_walk
+#define WP_WALK_LEAF instance_leaf
+#include "traverse_walk.def"
+#endif
+#endif /* WP_BVH_INSTANCES */
+
+/* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
+ * hit; the hit record holds the closest one found. */
+static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
+                             bool any) {
+  hit->t = tmax;
+#if WP_BVH_INSTANCES
+  hit->inst = WP_NO_INSTANCE;
+  return top_walk(scene, r, 0, hit, any);
+#else
+  return mesh_walk(scene, r, 0, hit, any);
+#endif
+}
 
 #endif /* WP_TRAVERSE_H */

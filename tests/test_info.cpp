@@ -161,6 +161,8 @@ TEST_F(InfoCli, GpuInstancesArePlacedAndCounted) {
   const json j = info(path);
   expect_counts(j, f);
   EXPECT_EQ(j["triangles"], 125 * 12);
+  EXPECT_EQ(j["instances"], 125);  // instanced by default: the cube stored once
+  EXPECT_EQ(j["stored_triangles"], 12);
   EXPECT_EQ(j["gpu_instanced_nodes"], 1);
   const json* e = extension(j, "EXT_mesh_gpu_instancing");
   ASSERT_NE(e, nullptr);

@@ -1,5 +1,6 @@
 // kernel tier: the ray-tracing stage kernels (intersect_closest, trace_shadow) against Embree's own
-// rtcIntersect1 / rtcOccluded1 on the same triangles, on PoCL.
+// rtcIntersect1 / rtcOccluded1 on the same triangles, on PoCL; for instanced scenes (a two-level
+// BVH, WP_BVH_INSTANCES) against Embree's own instancing (RTC_GEOMETRY_TYPE_INSTANCE).
 //
 // Expected agreement: the same hit/miss and the same triangle, t within 1e-4 relative plus the
 // rounding every float implementation has (t_rounding below). The only
@@ -11,8 +12,10 @@
 #include <embree3/rtcore.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
@@ -35,6 +38,51 @@ struct EmbreeScene : wp::bvh::EmbreeScene {
       : wp::bvh::EmbreeScene(s.positions.data(), s.positions.size(), s.indices.data(),
                              s.triangle_count(), /*robust=*/true) {}
 };
+
+// The oracle for an instanced scene: Embree's instances of the scene's meshes. Hits are named by
+// their triangle in the scene's flattened twin (flat_twin), as the kernel's are.
+struct EmbreeInstanced {
+  explicit EmbreeInstanced(const wp::Scene& s) : scene(s), embree(make(s)) {}
+  static wp::bvh::EmbreeInstances make(const wp::Scene& s) {
+    std::vector<wp::bvh::EmbreeInstances::MeshRange> meshes;
+    for (const wp::MeshRange& m : s.meshes) meshes.push_back({m.first_triangle, m.triangle_count});
+    std::vector<wp::bvh::InstanceInput> instances;
+    for (const wp::Instance& i : s.instances) instances.push_back({i.to_world, i.mesh});
+    return wp::bvh::EmbreeInstances(s.positions.data(), s.indices.data(), meshes, instances,
+                                    /*robust=*/true);
+  }
+  const wp::Scene& scene;
+  wp::bvh::EmbreeInstances embree;
+};
+
+// The world of an instanced scene flattened: each instance's triangles mapped into the world, in
+// instance order (what its hits are compared in), and where each instance's triangles start.
+struct FlatTwin {
+  wp::Scene scene;
+  std::vector<std::uint32_t> base;
+  std::uint32_t triangle(const wp::Scene& instanced, std::uint32_t inst, std::uint32_t tri) const {
+    return base[inst] + (tri - instanced.meshes[instanced.instances[inst].mesh].first_triangle);
+  }
+};
+FlatTwin flat_twin(const wp::Scene& s) {
+  FlatTwin f;
+  f.scene.materials = s.materials;
+  for (const wp::Instance& inst : s.instances) {
+    f.base.push_back(static_cast<std::uint32_t>(f.scene.triangle_count()));
+    const wp::MeshRange& m = s.meshes[inst.mesh];
+    for (std::uint32_t t = m.first_triangle; t < m.first_triangle + m.triangle_count; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec4 p(s.positions[s.indices[3 * t + k]], 1.0);
+        f.scene.indices.push_back(static_cast<std::uint32_t>(f.scene.positions.size()));
+        f.scene.positions.push_back(glm::vec3(inst.to_world * p));
+        f.scene.normals.push_back({0, 0, 1});
+      }
+      f.scene.triangle_material.push_back(s.triangle_material[t]);
+    }
+  }
+  wp::test::finish_bounds(f.scene);
+  return f;
+}
 
 struct Rays {
   std::vector<float4> o, d;  // o.w = tmin, d.w = tmax
@@ -113,10 +161,43 @@ class IntersectKernel : public ::testing::Test {
     }
   }
 
+  // A hit of the oracle or the kernel: its triangle in `world`'s numbering.
+  struct WorldHit {
+    bool hit = false;
+    float t = 0.0f;
+    std::uint32_t tri = 0;
+  };
+
   void check_closest(const wp::Scene& scene, const Rays& rays, int width) {
+    if (!scene.instances.empty()) {
+      const FlatTwin twin = flat_twin(scene);
+      const EmbreeInstanced embree(scene);
+      check_closest(
+          scene, twin.scene, rays, width,
+          [&](const wp::bvh::Ray& r) {
+            const wp::bvh::Hit h = embree.embree.intersect(r);
+            return WorldHit{h.hit, h.t, h.hit ? twin.triangle(scene, h.instance, h.triangle) : 0};
+          },
+          [&](std::uint32_t inst, std::uint32_t tri) { return twin.triangle(scene, inst, tri); });
+      return;
+    }
+    const EmbreeScene embree(scene);
+    check_closest(
+        scene, scene, rays, width,
+        [&](const wp::bvh::Ray& r) {
+          const wp::bvh::Hit h = embree.intersect(r);
+          return WorldHit{h.hit, h.t, h.triangle};
+        },
+        [](std::uint32_t, std::uint32_t tri) { return tri; });
+  }
+
+  // The kernel's hits on `scene` against `oracle`'s, both named by their triangle in `world`
+  // (the scene itself, or an instanced scene's flattened twin).
+  template <class Oracle, class ToWorld>
+  void check_closest(const wp::Scene& scene, const wp::Scene& world, const Rays& rays, int width,
+                     Oracle oracle, ToWorld to_world) {
     const wp::bvh::Bvh bvh = build(scene, width);
     wp::Wavefront wf(*runtime_, scene, bvh, settings());
-    EmbreeScene embree(scene);
     std::size_t ties = 0, hits = 0;
     for (std::size_t first = 0; first < rays.o.size(); first += kWave) {
       const std::size_t n = std::min<std::size_t>(kWave, rays.o.size() - first);
@@ -130,32 +211,36 @@ class IntersectKernel : public ::testing::Test {
       p.queue_in = WP_QUEUE_RAY_A;
       wf.launch_stage(wp::Stage::kIntersectClosest, static_cast<std::uint32_t>(n), p);
       const auto hit = wf.read_paths<float4>(layout.hit, n);
+      const auto instance = scene.instances.empty()
+                                ? std::vector<wp::dev::uint>(n, 0u)
+                                : wf.read_paths<wp::dev::uint>(layout.hit_instance, n);
       for (std::size_t i = 0; i < n; ++i) {
         const float4 o = rays.o[first + i], d = rays.d[first + i];
-        RTCRayHit rh{};
-        rh.ray = {o.x, o.y, o.z, o.w, d.x, d.y, d.z, 0.0f, d.w, ~0u, 0, 0};  // mask: all
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        rtcIntersect1(embree.handle(), &ctx, &rh);
-        const bool ours = hit[i].x < INFINITY, theirs = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        const glm::vec3 go(o.x, o.y, o.z), gd(d.x, d.y, d.z);
+        const WorldHit theirs = oracle(wp::bvh::Ray{go, gd, o.w, d.w});
+        WorldHit ours;
+        ours.hit = hit[i].x < INFINITY;
+        ours.t = hit[i].x;
         std::uint32_t our_tri;
         std::memcpy(&our_tri, &hit[i].w, 4);
-        const glm::vec3 go(o.x, o.y, o.z), gd(d.x, d.y, d.z);
-        hits += theirs;
-        if (ours != theirs) {
-          const std::uint32_t tri = ours ? our_tri : rh.hit.primID;
-          ASSERT_LT(border_distance(scene, tri, go, gd), 1e-4f)
+        if (ours.hit) ours.tri = to_world(instance[i], our_tri);
+        hits += theirs.hit;
+        if (ours.hit != theirs.hit) {
+          const std::uint32_t tri = ours.hit ? ours.tri : theirs.tri;
+          ASSERT_LT(border_distance(world, tri, go, gd), 1e-4f)
               << "hit/miss differs away from an edge, ray " << first + i;
           ++ties;
-        } else if (ours) {
-          const glm::vec3 ng = glm::normalize(glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
-          EXPECT_LE(std::fabs(hit[i].x - rh.ray.tfar),
-                    1e-4f * rh.ray.tfar + t_rounding(scene, std::fabs(glm::dot(ng, gd))))
-              << "ray " << first + i << ": t " << hit[i].x << " vs Embree's " << rh.ray.tfar;
+        } else if (ours.hit) {
+          const std::uint32_t* v = &world.indices[3 * std::size_t{theirs.tri}];
+          const glm::vec3 ng =
+              glm::normalize(glm::cross(world.positions[v[1]] - world.positions[v[0]],
+                                        world.positions[v[2]] - world.positions[v[0]]));
+          EXPECT_LE(std::fabs(ours.t - theirs.t),
+                    1e-4f * theirs.t + t_rounding(world, std::fabs(glm::dot(ng, gd))))
+              << "ray " << first + i << ": t " << ours.t << " vs Embree's " << theirs.t;
           // Another triangle at the same t (checked just above) is a tie: a shared edge or
           // vertex, or coincident faces (the CornellBox asset's light lies on its ceiling).
-          ties += our_tri != rh.hit.primID;
+          ties += ours.tri != theirs.tri;
         }
       }
     }
@@ -167,7 +252,12 @@ class IntersectKernel : public ::testing::Test {
   void check_shadow(const wp::Scene& scene, std::size_t count, std::uint32_t seed, int width) {
     const wp::bvh::Bvh bvh = build(scene, width);
     wp::Wavefront wf(*runtime_, scene, bvh, settings());
-    EmbreeScene embree(scene);
+    std::optional<EmbreeScene> flat;
+    std::optional<EmbreeInstanced> instanced;
+    if (scene.instances.empty())
+      flat.emplace(scene);
+    else
+      instanced.emplace(scene);
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     const auto in_box = [&] {
@@ -193,12 +283,10 @@ class IntersectKernel : public ::testing::Test {
                       wf.launch_params(0, 0, static_cast<std::uint32_t>(n)));
       const auto radiance = wf.read_paths<float4>(layout.radiance, n);
       for (std::size_t i = 0; i < n; ++i) {
-        RTCRay ray{so[i].x, so[i].y, so[i].z, 0.0f, sd[i].x, sd[i].y,
-                   sd[i].z, 0.0f,    so[i].w, ~0u,  0,       0};
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        rtcOccluded1(embree.handle(), &ctx, &ray);
-        const bool theirs = ray.tfar < 0.0f, ours = radiance[i].x == 0.0f;
+        const wp::bvh::Ray ray{
+            {so[i].x, so[i].y, so[i].z}, {sd[i].x, sd[i].y, sd[i].z}, 0.0f, so[i].w};
+        const bool theirs = flat ? flat->occluded(ray) : instanced->embree.occluded(ray);
+        const bool ours = radiance[i].x == 0.0f;
         occluded += theirs;
         mismatches += ours != theirs;
         ++total;
@@ -210,6 +298,8 @@ class IntersectKernel : public ::testing::Test {
     EXPECT_LT(occluded, total - total / 20);
   }
 
+  // The scene's BVH without culling flags (Embree culls nothing): one tree, or the two-level BVH
+  // of an instanced scene.
   static wp::bvh::Bvh build(const wp::Scene& s, int width) {
     wp::bvh::BuildInput in;
     in.positions = s.positions.data();
@@ -217,7 +307,19 @@ class IntersectKernel : public ::testing::Test {
     in.triangle_count = s.triangle_count();
     wp::bvh::BuildOptions options;
     options.width = width;
-    return wp::bvh::build(in, options);
+    if (s.instances.empty()) return wp::bvh::build(in, options);
+    std::vector<wp::bvh::Bvh> meshes;
+    std::vector<std::uint32_t> first;
+    for (const wp::MeshRange& m : s.meshes) {
+      wp::bvh::BuildInput mesh = in;
+      mesh.indices += 3 * std::size_t{m.first_triangle};
+      mesh.triangle_count = m.triangle_count;
+      meshes.push_back(wp::bvh::build(mesh, options));
+      first.push_back(m.first_triangle);
+    }
+    std::vector<wp::bvh::InstanceInput> instances;
+    for (const wp::Instance& i : s.instances) instances.push_back({i.to_world, i.mesh});
+    return wp::bvh::build_two_level(std::move(meshes), first, instances, options);
   }
   static wp::RenderSettings settings() {
     wp::RenderSettings s;
@@ -262,6 +364,45 @@ TEST_F(IntersectKernel, ShadowRaysMatchEmbree) {
   wp::test::add_sphere(s, {0.5f, 0.5f, 0.5f}, 0.3f, 48, 96, 0);
   wp::test::finish_bounds(s);
   check_shadow(s, 100000, 3);
+}
+
+// Two meshes (a sphere and a soup) placed 40 times: rotated, scaled 0.3 to 1.5 per axis, one in
+// three mirrored, overlapping.
+wp::Scene instanced_scene(std::uint32_t seed) {
+  wp::Scene s = one_material_scene();
+  wp::test::add_sphere(s, {0, 0, 0}, 1.0f, 32, 64, 0);
+  s.meshes.push_back({0, static_cast<std::uint32_t>(s.triangle_count())});
+  const auto soup_first = static_cast<std::uint32_t>(s.triangle_count());
+  wp::test::add_random_soup(s, 2000, 0.05f, seed, 0);
+  s.meshes.push_back({soup_first, static_cast<std::uint32_t>(s.triangle_count()) - soup_first});
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 40; ++i) {
+    const glm::dvec3 at(4.0 * u(rng), 4.0 * u(rng), 4.0 * u(rng));
+    const glm::dvec3 axis = glm::normalize(glm::dvec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
+    glm::dvec3 scale(0.3 + 1.2 * u(rng), 0.3 + 1.2 * u(rng), 0.3 + 1.2 * u(rng));
+    if (i % 3 == 0) scale.z = -scale.z;
+    wp::Instance inst;
+    inst.to_world = glm::translate(glm::dmat4(1.0), at) *
+                    glm::rotate(glm::dmat4(1.0), 6.2831853 * u(rng), axis) *
+                    glm::scale(glm::dmat4(1.0), scale);
+    inst.mesh = static_cast<std::uint32_t>(i % 2);
+    s.instances.push_back(inst);
+  }
+  const FlatTwin twin = flat_twin(s);
+  s.bounds_lo = twin.scene.bounds_lo;
+  s.bounds_hi = twin.scene.bounds_hi;
+  return s;
+}
+
+TEST_F(IntersectKernel, InstancesMatchEmbreeInstancing) {
+  const wp::Scene s = instanced_scene(4);
+  check_closest(s, make_rays(s, 100000, 7));
+}
+
+TEST_F(IntersectKernel, InstancedShadowRaysMatchEmbreeInstancing) {
+  const wp::Scene s = instanced_scene(5);
+  check_shadow(s, 100000, 8);
 }
 
 // Real models, when ../shared/assets is there.

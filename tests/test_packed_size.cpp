@@ -428,6 +428,8 @@ TEST(PathState, FusedStateIs112BytesAndSharesOnlyTheHitRecord) {
   v.push_back({#name, s.layout.name, sizeof(dev::type)});
 #define WP_PATH_AOV_FIELD(type, name, description) \
   v.push_back({#name, s.layout.name, aov ? sizeof(dev::type) : 0});
+#define WP_PATH_INSTANCE_FIELD(type, name, description) \
+  v.push_back({#name, s.layout.name, features.instances ? sizeof(dev::type) : 0});
 #define WP_PATH_SURF_FIELD(type, name, description) \
   v.push_back({#name, s.layout.name, fused ? 0 : sizeof(dev::type)});
 #define WP_PATH_OPT_FIELD(needs, type, name, description) \
@@ -438,14 +440,17 @@ TEST(PathState, FusedStateIs112BytesAndSharesOnlyTheHitRecord) {
 #undef WP_PATH_ALIAS_FIELD
 #undef WP_PATH_OPT_FIELD
 #undef WP_PATH_SURF_FIELD
+#undef WP_PATH_INSTANCE_FIELD
 #undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
     return v;
   };
+  SceneFeatures instanced = SceneFeatures::of(Scene{}, false);
+  instanced.instances = true;
   for (const bool fused : {true, false})
     for (const bool aov : {false, true})
       for (const SceneFeatures& features :
-           {SceneFeatures::all(), SceneFeatures::of(Scene{}, false)}) {
+           {SceneFeatures::all(), SceneFeatures::of(Scene{}, false), instanced}) {
         SCOPED_TRACE(std::string(fused ? "fused" : "split") + (aov ? ", AOVs" : ""));
         const PathStateLayout s = path_state_layout(kCapacity, aov, features, fused);
         const std::vector<Field> v = fields(s, aov, fused, features);
@@ -453,7 +458,8 @@ TEST(PathState, FusedStateIs112BytesAndSharesOnlyTheHitRecord) {
         for (const Field& f : v)
           extensions += std::string(f.name).rfind("surf_", 0) == 0 && f.bytes;
         const std::size_t expected = fused ? 112 : 208 + 16 * (extensions - 5);
-        EXPECT_EQ(s.bytes_per_path, expected + (aov ? 32 : 0));
+        // A two-level BVH adds the hit's instance (4 bytes).
+        EXPECT_EQ(s.bytes_per_path, expected + (aov ? 32 : 0) + (features.instances ? 4 : 0));
         for (std::size_t i = 0; i < v.size(); ++i) {
           EXPECT_LE(v[i].offset + v[i].bytes * kCapacity, s.bytes) << v[i].name;
           for (std::size_t j = i + 1; j < v.size(); ++j) {

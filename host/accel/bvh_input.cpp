@@ -1,5 +1,6 @@
 #include "host/accel/bvh_input.h"
 
+#include "host/accel/bvh_cache.h"
 #include "kernels/shared/types.h"
 
 namespace wp {
@@ -19,6 +20,34 @@ bvh::BuildInput bvh_input(const Scene& scene, std::vector<std::uint32_t>& flags)
   }
   input.triangle_flags = flags.data();
   return input;
+}
+
+bvh::Bvh build_scene_bvh(const Scene& scene, const bvh::BuildOptions& options,
+                         const std::string& cache_dir, bool* cached,
+                         const std::function<void(const bvh::Bvh&)>& accept) {
+  std::vector<std::uint32_t> flags;
+  const bvh::BuildInput input = bvh_input(scene, flags);
+  if (scene.instances.empty()) return bvh::build_cached(input, options, cache_dir, cached, accept);
+  std::vector<bvh::Bvh> meshes;
+  std::vector<std::uint32_t> first;
+  bool all_cached = true;
+  for (const MeshRange& m : scene.meshes) {
+    bvh::BuildInput mesh = input;
+    mesh.indices = input.indices + 3 * std::size_t{m.first_triangle};
+    mesh.triangle_flags = input.triangle_flags + m.first_triangle;
+    mesh.triangle_count = m.triangle_count;
+    bool hit = false;
+    meshes.push_back(bvh::build_cached(mesh, options, cache_dir, &hit));
+    all_cached &= hit;
+    first.push_back(m.first_triangle);
+  }
+  std::vector<bvh::InstanceInput> instances;
+  instances.reserve(scene.instances.size());
+  for (const Instance& i : scene.instances) instances.push_back({i.to_world, i.mesh});
+  bvh::Bvh out = bvh::build_two_level(std::move(meshes), first, instances, options);
+  if (cached) *cached = all_cached;
+  if (accept) accept(out);
+  return out;
 }
 
 }  // namespace wp

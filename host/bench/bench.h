@@ -12,6 +12,7 @@
 #include "host/device/cl_runtime.h"
 #include "host/util/error.h"
 #include "host/render/wavefront.h"
+#include "host/scene/gltf_loader.h"
 
 namespace wp::bench {
 
@@ -27,7 +28,8 @@ struct Options {
   std::string device;           // --device: index or name substring; empty: the default device
   int bvh_width = 0;            // --bvh-width 2|8; 0: the device's default (render.h)
   bool spatial_splits = false;  // --spatial-splits
-  bool user_min_time = false;   // --benchmark_min_time given: no benchmark sets its own
+  Instancing instancing = Instancing::kAuto;  // --instancing on|off|auto, as render's
+  bool user_min_time = false;  // --benchmark_min_time given: no benchmark sets its own
 };
 
 // Set once in main before any benchmark runs.

@@ -55,6 +55,8 @@ constexpr const char* kUsage =
     "  --device D      OpenCL device index or name substring (default: first GPU, else CPU)\n"
     "  --bvh-width W   BVH layout, 2 or 8 (default: 2 on GPUs, 8 on CPUs)\n"
     "  --spatial-splits  build the BVH with spatial splits\n"
+    "  --instancing M  meshes placed more than once: on (instances, a two-level BVH), off\n"
+    "                  (flattened copies) or auto (default; as wavepath render --instancing)\n"
     "\n"
     "Benchmarks: <stage>/bounce<0|1>/<scene> and accumulate/final/<scene> (one kernel launch on\n"
     "captured state, device time), render/<scene>, bvh_build/<scene>, program_build/<scene>.\n"
@@ -118,7 +120,8 @@ Options parse_options(int& argc, char** argv) {
       o.spatial_splits = true;
       continue;
     }
-    for (const char* name : {"--scene", "--width", "--height", "--device", "--bvh-width"}) {
+    for (const char* name :
+         {"--scene", "--width", "--height", "--device", "--bvh-width", "--instancing"}) {
       const std::string n = name;
       if (arg == n) {
         if (i + 1 >= argc) throw Error(n + " needs a value");
@@ -142,6 +145,13 @@ Options parse_options(int& argc, char** argv) {
     if (arg == "--width") o.width = parse_size(arg, value);
     if (arg == "--height") o.height = parse_size(arg, value);
     if (arg == "--device") o.device = value;
+    if (arg == "--instancing") {
+      if (value != "on" && value != "off" && value != "auto")
+        throw Error("--instancing must be on, off or auto");
+      o.instancing = value == "on"    ? Instancing::kAlways
+                     : value == "off" ? Instancing::kNever
+                                      : Instancing::kAuto;
+    }
     if (arg == "--bvh-width") {
       o.bvh_width = parse_size(arg, value);
       if (o.bvh_width != 2 && o.bvh_width != 8) throw Error("--bvh-width must be 2 or 8");

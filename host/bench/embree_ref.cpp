@@ -59,19 +59,32 @@ double run_passes(RTCScene scene, const std::vector<RefRay>& rays, bool occlusio
 
 }  // namespace
 
-EmbreeRef::EmbreeRef(const Scene& s)
-    : scene_(s.positions.data(), s.positions.size(), s.indices.data(), s.triangle_count(),
-             /*robust=*/false) {}
+EmbreeRef::EmbreeRef(const Scene& s) {
+  if (s.instances.empty()) {
+    flat_ = std::make_unique<bvh::EmbreeScene>(s.positions.data(), s.positions.size(),
+                                               s.indices.data(), s.triangle_count(),
+                                               /*robust=*/false);
+    handle_ = flat_->handle();
+    return;
+  }
+  std::vector<bvh::EmbreeInstances::MeshRange> meshes;
+  for (const MeshRange& m : s.meshes) meshes.push_back({m.first_triangle, m.triangle_count});
+  std::vector<bvh::InstanceInput> instances;
+  for (const Instance& i : s.instances) instances.push_back({i.to_world, i.mesh});
+  instanced_ = std::make_unique<bvh::EmbreeInstances>(s.positions.data(), s.indices.data(), meshes,
+                                                      instances, /*robust=*/false);
+  handle_ = instanced_->handle();
+}
 
 RefTiming EmbreeRef::measure(const std::vector<RefRay>& rays, bool occlusion, unsigned threads,
                              double min_seconds) const {
   RefTiming t;
   if (rays.empty()) return t;
   threads = std::max(threads, 1u);
-  const double warm = run_passes(scene_.handle(), rays, occlusion, threads, 1, t.hits);
+  const double warm = run_passes(handle_, rays, occlusion, threads, 1, t.hits);
   t.passes = static_cast<std::size_t>(
       std::clamp(std::ceil(min_seconds / std::max(warm, 1e-6)), 1.0, 10000.0));
-  t.seconds_per_pass = run_passes(scene_.handle(), rays, occlusion, threads, t.passes, t.hits) /
+  t.seconds_per_pass = run_passes(handle_, rays, occlusion, threads, t.passes, t.hits) /
                        static_cast<double>(t.passes);
   return t;
 }

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "host/accel/bvh_input.h"
 #include "host/bench/bench.h"
 #include "host/bench/scene_bench.h"
 #include "host/scene/gltf_loader.h"
@@ -74,6 +75,7 @@ void run_render(benchmark::State& state, const SceneSpec& spec) {
                          benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
   state.counters["wave_size"] = static_cast<double>(wf.wave_paths());
   state.counters["triangles"] = static_cast<double>(sb.scene().triangle_count());
+  state.counters["instances"] = static_cast<double>(sb.scene().instances.size());
 }
 
 // --- bvh_build ---------------------------------------------------------------------------------
@@ -82,7 +84,7 @@ void run_bvh_build(benchmark::State& state, const SceneSpec& spec) {
   SceneBench& sb = scene_bench(spec);
   bvh::BuildStats stats;
   for (auto _ : state) {
-    const bvh::Bvh bvh = bvh::build(sb.bvh_input(), build_options());
+    const bvh::Bvh bvh = build_scene_bvh(sb.scene(), build_options(), std::string());
     stats = bvh.stats;
   }
   state.counters["sah_cost"] = stats.sah_cost;
@@ -214,7 +216,7 @@ int run_startup_probe(int argc, char** argv) {
     env().options.width = std::stoi(argv[3]);
     env().options.height = std::stoi(argv[4]);
     ClRuntime runtime(select_device(argv[5]));
-    const Scene scene = load_gltf(argv[2]);
+    const Scene scene = load_gltf(argv[2], load_options());
     RenderSettings settings = bench_settings(false);
     settings.spp = 1;
     settings.kernel_cache_dir =

@@ -26,11 +26,17 @@ bool in_bounce(Stage s) {
 }  // namespace
 
 SceneBench::SceneBench(const SceneSpec& spec)
-    : spec_(spec), scene_(load_gltf(spec.path)), bvh_input_(wp::bvh_input(scene_, tri_flags_)) {
-  bvh_ = bvh::build(bvh_input_, build_options());
+    : spec_(spec), scene_(load_gltf(spec.path, load_options())) {
+  bvh_ = build_scene_bvh(scene_, build_options(), std::string());
   const RenderSettings s = bench_settings(false);
   const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
   wave_paths_ = static_cast<std::uint32_t>(std::min(pixels, std::size_t(1) << 20));
+}
+
+LoadOptions load_options() {
+  LoadOptions o;
+  o.instancing = env().options.instancing;
+  return o;
 }
 
 // The BVH options a render on the bench's device would use.

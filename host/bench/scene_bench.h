@@ -47,7 +47,6 @@ class SceneBench {
 
   const SceneSpec& spec() const { return spec_; }
   const Scene& scene() const { return scene_; }
-  const bvh::BuildInput& bvh_input() const { return bvh_input_; }
   const bvh::Bvh& bvh() const { return bvh_; }
   std::uint32_t wave_paths() const { return wave_paths_; }
 
@@ -77,8 +76,6 @@ class SceneBench {
 
   SceneSpec spec_;
   Scene scene_;
-  std::vector<std::uint32_t> tri_flags_;
-  bvh::BuildInput bvh_input_;
   bvh::Bvh bvh_;
   std::uint32_t wave_paths_ = 0;
   std::unique_ptr<Wavefront> stages_;
@@ -103,5 +100,7 @@ void release_scene_bench();
 // back-face culling and alpha, filled into `flags`, which must outlive the input.
 // The BVH options a render on the bench's device would use (width, spatial splits).
 bvh::BuildOptions build_options();
+// How the bench loads its scenes (--instancing).
+LoadOptions load_options();
 
 }  // namespace wp::bench

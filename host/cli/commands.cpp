@@ -124,6 +124,7 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   // before the scene loads, so that a scene it cannot hold is refused from its counts.
   const wp::DeviceEntry device = wp::select_device(cli.device, ranks.local_rank());
   wp::LoadOptions load{cli.variant};
+  load.instancing = wp::cli::instancing_mode(cli.instancing);
   load.check_counts = [&](const wp::LoadCounts& counts) {
     wp::check_scene_counts(counts, device, mine);
   };

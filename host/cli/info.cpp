@@ -7,6 +7,7 @@
 
 #include "host/accel/bvh_cache.h"
 #include "host/accel/bvh_input.h"
+#include "host/cli/options.h"
 #include "host/lights/light_table.h"
 #include "host/render/render.h"
 #include "host/scene/gltf_loader.h"
@@ -18,6 +19,7 @@ void add_info_options(CLI::App* info, InfoOptions& o) {
   info->add_option("scene", o.scene, "glTF 2.0 file (.gltf or .glb)")->required();
   info->add_option("--variant", o.variant,
                    "Material variant (KHR_materials_variants) by name, as render takes it");
+  add_instancing_option(info, o.instancing);
   info->add_option("--width", o.width, "Image width in pixels, for the film and the wave")
       ->capture_default_str();
   info->add_option("--height", o.height, "Image height in pixels, for the film and the wave")
@@ -45,7 +47,13 @@ BvhInfo bvh_info(const Scene& scene, const bvh::BuildInput& input, int width, bo
   options.spatial_splits = spatial_splits;
   const std::string dir = cache_dir();
   std::optional<bvh::Bvh> bvh;
-  if (scene.triangle_count() == 0) {
+  if (!scene.instances.empty()) {
+    b.cache = "per mesh";  // a two-level BVH: each mesh's tree is an entry of its own
+    if (build) {
+      bvh = build_scene_bvh(scene, options, std::string());
+      b.source = "built";
+    }
+  } else if (scene.triangle_count() == 0) {
     b.cache = "never";
   } else if (dir.empty()) {
     b.cache = "no folder";
@@ -58,9 +66,9 @@ BvhInfo bvh_info(const Scene& scene, const bvh::BuildInput& input, int width, bo
     bvh = bvh::cache_load(dir, key, scene.triangle_count(), options);
     b.cache = bvh ? "valid" : ec ? "absent" : "unusable";
   }
-  if (bvh) {
+  if (bvh && b.source.empty()) {
     b.source = "cache";
-  } else if (build || scene.triangle_count() == 0) {  // no triangles: nothing to build
+  } else if (!bvh && (build || scene.triangle_count() == 0)) {  // no triangles: nothing to build
     bvh = bvh::build(input, options);
     b.source = "built";
   }
@@ -112,6 +120,7 @@ int info_command(const InfoOptions& options) {
   std::optional<Scene> scene;
   try {
     LoadOptions load(options.variant);
+    load.instancing = instancing_mode(options.instancing);
     load.check_counts = check_host_counts;  // a scene the host cannot load is refused first
     scene = load_gltf(options.scene, load);
   } catch (const RefusedExtensions& e) {

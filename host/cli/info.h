@@ -29,7 +29,8 @@ namespace wp::cli {
 
 struct InfoOptions {
   std::string scene;
-  std::string variant;  // --variant, as render's
+  std::string variant;              // --variant, as render's
+  std::string instancing = "auto";  // --instancing, as render's
   int width = RenderSettings{}.width, height = RenderSettings{}.height;
   int bvh_width = 0;  // 2 or 8; 0: both
   bool spatial_splits = false;
@@ -49,7 +50,8 @@ struct BvhInfo {
   SceneLayout layout;  // the packed scene with these sizes
   // The cache: "valid" (a render loads it), "absent", "unusable" (present but failing the
   // checks of bvh_cache.h: a render rebuilds and replaces it), "no folder" (cache_dir() is
-  // empty) or "never" (a scene without triangles is never cached).
+  // empty), "never" (a scene without triangles is never cached) or "per mesh" (an instanced
+  // scene's two-level BVH: each mesh's tree is cached, built here without the cache).
   std::string cache;
   std::string cache_file;  // empty without a cache folder
   std::uint64_t cache_file_bytes = 0;

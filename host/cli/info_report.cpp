@@ -51,17 +51,26 @@ void text_extensions(std::ostringstream& o, const std::vector<ExtensionUse>& use
 
 void text_geometry(std::ostringstream& o, const Scene& s) {
   const GltfSummary& g = s.gltf;
-  line(o, "geometry",
-       std::to_string(s.triangle_count()) + " triangles, " + std::to_string(s.positions.size()) +
-           " vertices (all instances)");
+  const bool instanced = !s.instances.empty();
+  if (instanced)
+    line(o, "geometry",
+         std::to_string(s.world_triangle_count()) +
+             " triangles in the world: " + std::to_string(s.instances.size()) + " instances of " +
+             std::to_string(s.meshes.size()) + " mesh(es) holding " +
+             std::to_string(s.triangle_count()) + " triangles, " +
+             std::to_string(s.positions.size()) + " vertices (a two-level BVH)");
+  else
+    line(o, "geometry",
+         std::to_string(s.triangle_count()) + " triangles, " + std::to_string(s.positions.size()) +
+             " vertices (all placements, each a copy)");
+  const std::string each = instanced ? "each an instance of its mesh" : "each a copy of its mesh";
   line(o, "meshes",
        std::to_string(g.meshes) + " in the file, " + std::to_string(g.meshes_placed) +
-           " placed by " + std::to_string(g.mesh_nodes) +
-           " node(s): instances, each a copy of its mesh's triangles");
+           " placed by " + std::to_string(g.mesh_nodes) + " node(s): " + each);
   if (g.gpu_instanced_nodes)
     line(o, "",
          "EXT_mesh_gpu_instancing: " + std::to_string(g.gpu_instances) + " instances on " +
-             std::to_string(g.gpu_instanced_nodes) + " node(s), each a copy of its mesh");
+             std::to_string(g.gpu_instanced_nodes) + " node(s), " + each);
 }
 
 void text_materials(std::ostringstream& o, const Scene& s, const SceneInfo& info) {
@@ -177,9 +186,10 @@ std::string json_extensions(const std::vector<ExtensionUse>& uses) {
 
 void json_contents(std::ostringstream& o, const Scene& s, const SceneInfo& info) {
   const GltfSummary& g = s.gltf;
-  o << ",\"triangles\":" << s.triangle_count() << ",\"vertices\":" << s.positions.size()
-    << ",\"meshes\":" << g.meshes << ",\"meshes_placed\":" << g.meshes_placed
-    << ",\"mesh_instances\":" << g.mesh_nodes
+  o << ",\"triangles\":" << s.world_triangle_count()
+    << ",\"stored_triangles\":" << s.triangle_count() << ",\"instances\":" << s.instances.size()
+    << ",\"vertices\":" << s.positions.size() << ",\"meshes\":" << g.meshes
+    << ",\"meshes_placed\":" << g.meshes_placed << ",\"mesh_instances\":" << g.mesh_nodes
     << ",\"gpu_instanced_nodes\":" << g.gpu_instanced_nodes
     << ",\"gpu_instances\":" << g.gpu_instances << ",\"materials\":" << s.materials.size()
     << ",\"file_materials\":" << g.materials

@@ -242,6 +242,7 @@ void add_scene_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& setti
                   "nearest (the texel, blocky when magnified); importance sampling stays exact")
       ->check(CLI::IsMember({"bilinear", "nearest"}))
       ->capture_default_str();
+  add_instancing_option(app, cli.instancing);
   app->add_option("--mipmaps", cli.mipmaps,
                   "Textures seen small: on (each path's ray cone picks a level of the texture's "
                   "mip chain, trilinear: less noise, slightly blurred) or off (full resolution "
@@ -363,6 +364,22 @@ std::vector<std::string> written_files(const CliOptions& cli) {
 void check_exposure(const CliOptions& cli) {
   if (!std::isfinite(cli.exposure) || std::abs(cli.exposure) > 64.0f)
     throw wp::Error("--exposure must be a finite number of stops between -64 and 64");
+}
+
+void add_instancing_option(CLI::App* app, std::string& instancing) {
+  app->add_option("--instancing", instancing,
+                  "Meshes placed more than once: on (each mesh stored once, its placements as "
+                  "instances of a two-level BVH), off (every placement a copy in world space) or "
+                  "auto (on when the copies would hold at least twice the triangles of the "
+                  "meshes)")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+}
+
+wp::Instancing instancing_mode(const std::string& instancing) {
+  return instancing == "on"    ? wp::Instancing::kAlways
+         : instancing == "off" ? wp::Instancing::kNever
+                               : wp::Instancing::kAuto;
 }
 
 void add_render_options(CLI::App* render, CliOptions& cli, wp::RenderSettings& settings) {

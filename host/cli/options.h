@@ -10,6 +10,7 @@
 
 #include "host/cli/distributed.h"
 #include "host/render/wavefront.h"
+#include "host/scene/gltf_loader.h"
 
 namespace wp::cli {
 
@@ -27,6 +28,7 @@ struct CliOptions {
   std::string env;
   std::string env_filter = "bilinear";
   std::string mipmaps = "on";
+  std::string instancing = "auto";  // --instancing: auto, on or off
   std::string strategy = "mis";
   std::string heuristic = "power";
   std::string light_select = "power";
@@ -59,6 +61,9 @@ extern const std::vector<std::string> kAovNames;
 
 // Declares every option of `wavepath render` on `render`, bound to `cli` and `settings`.
 void add_render_options(CLI::App* render, CliOptions& cli, wp::RenderSettings& settings);
+// --instancing (render and info), and its value as the loader takes it.
+void add_instancing_option(CLI::App* app, std::string& instancing);
+wp::Instancing instancing_mode(const std::string& instancing);
 // Declares every option of `wavepath merge` on `merge`.
 void add_merge_options(CLI::App* merge, CliOptions& cli);
 

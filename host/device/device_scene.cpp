@@ -39,7 +39,7 @@ std::string too_many_texels() {
 
 // The arrays pack_scene packs, in its order (SceneDesc's); the environment's three come last and
 // only with a map.
-constexpr std::array<const char*, 18> kArrayNames = {"BVH node",
+constexpr std::array<const char*, 20> kArrayNames = {"BVH node",
                                                      "BVH triangle",
                                                      "triangle vertex",
                                                      "position",
@@ -56,7 +56,9 @@ constexpr std::array<const char*, 18> kArrayNames = {"BVH node",
                                                      "triangle light",
                                                      "environment texel",
                                                      "environment marginal",
-                                                     "environment conditional"};
+                                                     "environment conditional",
+                                                     "instance",
+                                                     "instance reference"};
 
 dev::Material device_material(const Material& m) {
   dev::Material d{};
@@ -290,6 +292,21 @@ std::vector<SceneArray> scene_arrays(const Scene& scene, const bvh::Bvh& bvh, co
     arrays.push_back(copy_array(x.env->marginal, d.env_marginal));
     arrays.push_back(copy_array(x.env->conditional, d.env_conditional));
   }
+  if (!bvh.instances.empty()) {
+    if (!x.env) {  // the instance arrays' places are after the environment's
+      static const std::vector<float> none;
+      arrays.push_back(copy_array(none, d.env_texels));
+      arrays.push_back(copy_array(none, d.env_marginal));
+      arrays.push_back(copy_array(none, d.env_conditional));
+    }
+    const std::vector<dev::uint>& first_light = x.lights->instance_light;
+    arrays.push_back(convert_array(bvh.instances.size(), d.instances, [&](std::size_t i) {
+      dev::BvhInstance inst = bvh.instances[i];
+      inst.meta.y = i < first_light.size() ? first_light[i] : WP_NO_LIGHT;
+      return inst;
+    }));
+    arrays.push_back(copy_array(bvh.instance_refs, d.instance_refs));
+  }
   return arrays;
 }
 
@@ -402,6 +419,7 @@ SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mip
       c.texels += std::uint64_t(mip_size(img.width, k)) * std::uint64_t(mip_size(img.height, k));
   }
   c.lights = scene.lights.size();
+  c.instances = scene.instances.size();
   if (env) {
     c.env_texels = env->texels.size();
     c.env_marginal = env->marginal.size();
@@ -412,8 +430,10 @@ SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mip
 
 BvhBytes bvh_bytes(const bvh::Bvh& b) {
   if (b.width == WP_BVH8_WIDTH)
-    return {b.nodes8.size() * sizeof(dev::BvhNode8), b.blocks.size() * sizeof(dev::TriBlock4)};
-  return {b.nodes.size() * sizeof(dev::BvhNode), b.triangles.size() * sizeof(dev::IsectTri)};
+    return {b.nodes8.size() * sizeof(dev::BvhNode8), b.blocks.size() * sizeof(dev::TriBlock4),
+            b.instance_refs.size() * sizeof(std::uint32_t)};
+  return {b.nodes.size() * sizeof(dev::BvhNode), b.triangles.size() * sizeof(dev::IsectTri),
+          b.instance_refs.size() * sizeof(std::uint32_t)};
 }
 
 BvhBytes min_bvh_bytes(std::uint64_t triangles, int width) {
@@ -451,10 +471,14 @@ SceneLayout scene_layout(const SceneCounts& c, const BvhBytes& bvh, std::uint64_
                                       c.lights * sizeof(dev::Light),
                                       c.lights * sizeof(dev::LightAlias),
                                       c.triangles * sizeof(std::uint32_t)};  // tri_light
-  if (c.env_texels || c.env_marginal || c.env_conditional) {
+  if (c.env_texels || c.env_marginal || c.env_conditional || c.instances) {
     sizes.push_back(c.env_texels * sizeof(glm::vec4));
     sizes.push_back(c.env_marginal * sizeof(float));
     sizes.push_back(c.env_conditional * sizeof(float));
+  }
+  if (c.instances) {
+    sizes.push_back(c.instances * sizeof(dev::BvhInstance));
+    sizes.push_back(bvh.instance_refs);
   }
   return plan_scene_layout(sizes, max_buffer);
 }

@@ -126,7 +126,8 @@ struct SceneCounts {
   // size (LightTable::lights) makes the layout exact.
   std::uint64_t lights = 0;
   std::uint64_t env_texels = 0, env_marginal = 0, env_conditional = 0;  // no map: 0
-  VertexArrays vertex_arrays;  // those packed, as SceneExtras::vertex_arrays
+  std::uint64_t instances = 0;  // Scene::instances (a two-level BVH's)
+  VertexArrays vertex_arrays;   // those packed, as SceneExtras::vertex_arrays
 };
 // env may be null; `mipmaps` counts the mip chains pack_scene adds with SceneExtras::mipmaps.
 SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mipmaps = false);
@@ -134,6 +135,7 @@ SceneCounts scene_counts(const Scene& scene, const EnvironmentMap* env, bool mip
 // The bytes of the BVH's two packed arrays (nodes, then triangles or blocks).
 struct BvhBytes {
   std::uint64_t nodes = 0, primitives = 0;
+  std::uint64_t instance_refs = 0;  // a two-level BVH's top-level leaves (0: not known yet)
 };
 BvhBytes bvh_bytes(const bvh::Bvh& bvh);
 // At most the bytes of any BVH of layout `width` (2 or 8) over `triangles` triangles: every

@@ -33,6 +33,7 @@ SceneFeatures SceneFeatures::of(const Scene& scene, bool has_environment_map) {
     return x.emission.x > 0.0f || x.emission.y > 0.0f || x.emission.z > 0.0f;
   });
   f.environment = has_environment_map;
+  f.instances = !scene.instances.empty();
   f.vertex_colors = any(
       scene.color0, [](const glm::vec4& c) { return c.r != 1.0f || c.g != 1.0f || c.b != 1.0f; });
   f.textures = any(m, [](const Material& x) {

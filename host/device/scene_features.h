@@ -37,6 +37,11 @@ struct SceneFeatures {
   bool diffuse_transmission = true;  // diffuseTransmissionFactor > 0
   bool dispersion = true;            // dispersion > 0 on a transmissive material with a volume
 
+  // Not a material feature but the scene's structure: a two-level BVH (Scene::instances; built
+  // as -D WP_BVH_INSTANCES=1 beside WP_BVH_WIDTH). Off in all(); render_features sets it from the
+  // scene either way.
+  bool instances = false;
+
   static SceneFeatures all() { return {}; }
 
   // Which per-vertex arrays beyond positions and normals the program reads (kernels/material.h,

@@ -93,25 +93,70 @@ LightTable build_light_table(const Scene& scene, const EnvironmentMap* env, glm:
     power.push_back(punctual_power(l, radius));
   }
   t.tri_light.assign(scene.triangle_count(), WP_NO_LIGHT);
+  // The emissive triangles: the scene's, or each mesh's once for all its instances.
+  struct Emitter {
+    std::uint32_t triangle;
+    double luminance;  // power / (pi x area)
+  };
+  std::vector<Emitter> emitters;
+  std::vector<std::uint32_t> mesh_emitters;  // instanced: each mesh's first in emitters, + 1 end
+  const auto vertex = [&](std::size_t i, int k) {
+    return scene.positions[scene.indices[3 * i + k]];
+  };
+  const auto area = [&](std::size_t i) {  // in the scene's arrays (the world, unless instanced)
+    const glm::vec3 a = vertex(i, 0), b = vertex(i, 1), c = vertex(i, 2);
+    return 0.5 * glm::length(glm::cross(b - a, c - a));
+  };
   for (std::size_t i = 0; i < scene.triangle_count(); ++i) {
     const Material& m = scene.materials[scene.triangle_material[i]];
     const TriangleEmission e = triangle_emission(scene, i);
     if (e.zero()) continue;  // black everywhere (an emissive texture's dark part): not a light
-    const glm::vec3 a = scene.positions[scene.indices[3 * i]];
-    const glm::vec3 b = scene.positions[scene.indices[3 * i + 1]];
-    const glm::vec3 c = scene.positions[scene.indices[3 * i + 2]];
-    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
-    if (!(area > 0.0)) continue;  // a degenerate triangle emits nothing
-    dev::Light d{};
-    d.meta.x = WP_LIGHT_TRIANGLE;
-    d.meta.y = static_cast<dev::uint>(i);
-    t.tri_light[i] = static_cast<std::uint32_t>(t.lights.size());
-    t.lights.push_back(d);
+    if (!(area(i) > 0.0)) continue;  // a degenerate triangle emits nothing
     // The integrated emission; a triangle whose sampled mean is 0 but whose peak is not (a lit
     // spot between the grid points) keeps a small chance of being chosen.
     const double l = std::max(luminance(e.mean), 1e-3 * e.peak);
-    power.push_back(kPi * area * l * (m.double_sided ? 2.0 : 1.0));
+    emitters.push_back({static_cast<std::uint32_t>(i), l * (m.double_sided ? 2.0 : 1.0)});
+  }
+  const auto add = [&](const Emitter& e, double world_area, std::uint32_t instance) {
+    dev::Light d{};
+    d.meta.x = WP_LIGHT_TRIANGLE;
+    d.meta.y = e.triangle;
+    d.meta.z = instance;
+    t.lights.push_back(d);
+    power.push_back(kPi * world_area * e.luminance);
     ++t.emissive_triangles;
+  };
+  if (scene.instances.empty()) {
+    for (const Emitter& e : emitters) {
+      t.tri_light[e.triangle] = static_cast<std::uint32_t>(t.lights.size());
+      add(e, area(e.triangle), WP_NO_INSTANCE);
+    }
+  } else {
+    // Emitters are in triangle order, and meshes are triangle ranges in order.
+    std::size_t next = 0;
+    for (const MeshRange& mesh : scene.meshes) {
+      mesh_emitters.push_back(static_cast<std::uint32_t>(next));
+      for (std::uint32_t local = 0;
+           next < emitters.size() &&
+           emitters[next].triangle < mesh.first_triangle + mesh.triangle_count;
+           ++next, ++local)
+        t.tri_light[emitters[next].triangle] = local;
+    }
+    mesh_emitters.push_back(static_cast<std::uint32_t>(next));
+    t.instance_light.assign(scene.instances.size(), WP_NO_LIGHT);
+    for (std::size_t k = 0; k < scene.instances.size(); ++k) {
+      const Instance& inst = scene.instances[k];
+      const std::uint32_t first = mesh_emitters[inst.mesh], end = mesh_emitters[inst.mesh + 1];
+      if (first == end) continue;
+      t.instance_light[k] = static_cast<std::uint32_t>(t.lights.size());
+      for (std::uint32_t j = first; j < end; ++j) {
+        glm::dvec3 v[3];
+        for (int c = 0; c < 3; ++c)
+          v[c] = glm::dvec3(inst.to_world * glm::dvec4(vertex(emitters[j].triangle, c), 1.0));
+        const double world_area = 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+        add(emitters[j], world_area, static_cast<std::uint32_t>(k));
+      }
+    }
   }
   const double env_luminance = env ? env->mean_luminance * env_intensity : luminance(background);
   if (env_luminance > 0.0) {

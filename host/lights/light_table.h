@@ -26,8 +26,13 @@ enum class LightSelect { kUniform, kPower };
 
 struct LightTable {
   std::vector<dev::Light> lights;
-  std::vector<dev::LightAlias> alias;     // one per light
-  std::vector<std::uint32_t> tri_light;   // per scene triangle: index in lights, or WP_NO_LIGHT
+  std::vector<dev::LightAlias> alias;  // one per light
+  // Per scene triangle: index in lights, or WP_NO_LIGHT. In an instanced scene (Scene::instances)
+  // each instance of a mesh with emissive triangles has a light per emissive triangle, sampled with
+  // its world-space area, in the mesh's order from instance_light[instance] on; tri_light then
+  // holds a triangle's index among its mesh's emissive triangles (types.h, SceneDesc).
+  std::vector<std::uint32_t> tri_light;
+  std::vector<std::uint32_t> instance_light;
   std::uint32_t env_light = WP_NO_LIGHT;  // index of the environment light
   std::size_t emissive_triangles = 0;
 };

@@ -33,6 +33,8 @@ PathStateLayout path_state_layout(std::size_t capacity, bool aov, const SceneFea
   };
 #define WP_PATH_FIELD(type, name, description) s.layout.name = place(sizeof(type));
 #define WP_PATH_AOV_FIELD(type, name, description) s.layout.name = place(aov ? sizeof(type) : 0);
+#define WP_PATH_INSTANCE_FIELD(type, name, description) \
+  s.layout.name = place(features.instances ? sizeof(type) : 0);
 #define WP_PATH_SURF_FIELD(type, name, description) s.layout.name = place(fused ? 0 : sizeof(type));
 #define WP_PATH_OPT_FIELD(needs, type, name, description) \
   s.layout.name = place(!fused && uses_any(features, needs) ? sizeof(type) : 0);
@@ -42,6 +44,7 @@ PathStateLayout path_state_layout(std::size_t capacity, bool aov, const SceneFea
 #undef WP_PATH_ALIAS_FIELD
 #undef WP_PATH_OPT_FIELD
 #undef WP_PATH_SURF_FIELD
+#undef WP_PATH_INSTANCE_FIELD
 #undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
   s.layout.capacity = static_cast<uint>(capacity);

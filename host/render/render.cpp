@@ -86,6 +86,10 @@ std::string render_key(const Scene& scene, const RenderSettings& s, int bvh_widt
     << ";features=" << (s.all_features ? "all" : "scene") << ";bvh_width=" << bvh_width
     << ";spatial_splits=" << (spatial_splits ? 1 : 0) << ";aov=" << (s.aov ? 1 : 0)
     << ";kernels=" << hex64(kernel_digest);
+  // An instanced scene traverses a two-level BVH (the same image to float rounding, not bit for
+  // bit): its films do not merge with the flattened scene's. Only then, so that the keys of
+  // flattened scenes stay as they were.
+  if (!scene.instances.empty()) k << ";instances=" << scene.instances.size();
   return k.str();
 }
 
@@ -143,6 +147,10 @@ namespace {
 
 // The start of check_scene_counts' and check_host_counts' errors.
 std::string too_large(const LoadCounts& counts) {
+  if (counts.instanced)
+    return "scene too large: its " + std::to_string(counts.mesh_triangles) + " triangles in " +
+           std::to_string(counts.meshes) + " meshes (placed " + std::to_string(counts.placements) +
+           " times as instances) ";
   return "scene too large: its " + std::to_string(counts.triangles) + " triangles (" +
          std::to_string(counts.placements) + " mesh placements, each a copy of its mesh) ";
 }
@@ -155,7 +163,8 @@ std::uint64_t loading_bytes(std::uint64_t triangles) {
 }  // namespace
 
 void check_host_counts(const LoadCounts& counts) {
-  const std::uint64_t loading = loading_bytes(counts.triangles), available = available_memory();
+  const std::uint64_t loading = loading_bytes(counts.stored_triangles()),
+                      available = available_memory();
   if (available && loading > available)
     throw Error(too_large(counts) + "need at least " + gb(loading) + " of memory to load, " +
                 gb(available) + " are available");
@@ -165,7 +174,8 @@ void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
                         const RenderSettings& settings) {
   const std::string what = too_large(counts);
   SceneCounts least;
-  least.triangles = counts.triangles;
+  least.triangles = counts.stored_triangles();
+  if (counts.instanced) least.instances = counts.placements;
   std::uint64_t packed = 0;
   try {
     packed = scene_layout(least, min_bvh_bytes(least.triangles, bvh_width(device, settings)),
@@ -174,7 +184,7 @@ void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
   } catch (const Error& e) {  // an array larger than a buffer, or more than the buffers
     throw Error(what + "cannot be packed: " + e.what());
   }
-  const std::uint64_t loading = loading_bytes(counts.triangles), available = available_memory();
+  const std::uint64_t loading = loading_bytes(least.triangles), available = available_memory();
   if (device.gpu) {
     if (device.global_memory && packed > device.global_memory)
       throw Error(what + "pack into at least " + gb(packed) + ", " + device.name + " has " +
@@ -221,7 +231,6 @@ namespace {
 bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
                    const RenderOptions& options, const bvh::BuildOptions& bvh_options,
                    bool* cached) {
-  std::vector<std::uint32_t> flags;
   const SceneFeatures features = render_features(scene, settings);
   SceneCounts counts = scene_counts(scene, settings.environment.get(), features.texture_lod);
   counts.vertex_arrays = VertexArrays::of(features);
@@ -230,12 +239,12 @@ bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings&
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)
           .total_bytes(),
       runtime.device(), available_memory());
-  return bvh::build_cached(
-      bvh_input(scene, flags), bvh_options, options.bvh_cache ? cache_dir() : std::string(), cached,
-      [&](const bvh::Bvh& built) {
-        check_scene_memory(scene_layout(counts, bvh_bytes(built), max_buffer).total_bytes(),
-                           runtime.device(), available_memory());
-      });
+  return build_scene_bvh(scene, bvh_options, options.bvh_cache ? cache_dir() : std::string(),
+                         cached, [&](const bvh::Bvh& built) {
+                           check_scene_memory(
+                               scene_layout(counts, bvh_bytes(built), max_buffer).total_bytes(),
+                               runtime.device(), available_memory());
+                         });
 }
 
 // What the set-up made: device, program, BVH, wave and scene sizes.
@@ -245,6 +254,8 @@ void report_setup(RenderReport& r, const ClRuntime& runtime, const Scene& scene,
   r.features = wavefront.features().describe();
   r.build_options = wavefront.build_options();
   r.triangles = scene.triangle_count();
+  r.instances = scene.instances.size();
+  r.world_triangles = scene.world_triangle_count();
   r.bvh = bvh.stats;
   r.bvh_cached = bvh_cached;
   r.kernel_cached = wavefront.kernel_cached();

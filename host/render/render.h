@@ -35,7 +35,9 @@ struct RenderReport {
   std::string device;
   std::string features;       // the kernel features the program was built with
   std::string build_options;  // the program's build options
-  std::size_t triangles = 0;
+  std::size_t triangles = 0;  // stored: each instanced mesh once
+  // An instanced scene's instances and the triangles they place (else 0 and `triangles`).
+  std::uint64_t instances = 0, world_triangles = 0;
   bvh::BuildStats bvh;      // build_seconds: of the build, or of the cache look-up when cached
   bool bvh_cached = false;  // loaded from the BVH cache (host/accel/bvh_cache.h)
   bool kernel_cached =
@@ -120,9 +122,10 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
 // digest (Scene::digest), the environment map's (FNV-1a 64 of its texels, then env_filter) or none,
 // width, height,
 // max_depth, rr_depth, seed, background, env_intensity, env_rotation, strategy, mis_heuristic,
-// light_select, sampler, camera, features, bvh_width, spatial_splits and the kernels' source
-// digest. Not in it, as they do not change the image: the sample range, wave and work-group sizes,
-// the scene buffer limit, the device, caching, outputs and reporting.
+// light_select, sampler, camera, features, bvh_width, spatial_splits, the kernels' source
+// digest, and for an instanced scene its instance count. Not in it, as they do not change the
+// image: the sample range, wave and work-group sizes, the scene buffer limit, the device, caching,
+// outputs and reporting.
 std::string render_key(const Scene& scene, const RenderSettings& settings, int bvh_width,
                        bool spatial_splits, std::uint64_t kernel_digest);
 

@@ -70,6 +70,7 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"seconds\":" << num(r.render_seconds) << ",\"samples_rendered\":" << r.samples_rendered
     << ",\"samples_per_second\":" << num(r.samples_per_second(s))
     << ",\"device\":" << json_string(r.device) << ",\"triangles\":" << r.triangles
+    << ",\"instances\":" << r.instances << ",\"world_triangles\":" << r.world_triangles
     << ",\"kernel_build_seconds\":" << num(r.kernel_build_seconds)
     << ",\"kernel_binary_bytes\":" << r.kernel_binary_bytes
     << ",\"bvh_build_seconds\":" << num(r.bvh.build_seconds)

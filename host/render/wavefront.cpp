@@ -32,6 +32,7 @@ namespace {
 std::string program_options(const SceneFeatures& features, const RenderSettings& s, int bvh_width,
                             std::size_t group_size, bool prefetch) {
   std::string o = "-cl-std=CL1.2 -D WP_BVH_WIDTH=" + std::to_string(bvh_width);
+  if (features.instances) o += " -D WP_BVH_INSTANCES=1";
   o += " -D WP_GROUP_SIZE=" + std::to_string(group_size);
   if (prefetch) o += " -D WP_PREFETCH=1";
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
@@ -91,6 +92,7 @@ SceneFeatures render_features(const Scene& scene, const RenderSettings& settings
                         ? SceneFeatures::all()
                         : SceneFeatures::of(scene, settings.environment != nullptr);
   if (!settings.mipmaps) f.texture_lod = false;
+  f.instances = !scene.instances.empty();
   return f;
 }
 

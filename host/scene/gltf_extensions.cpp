@@ -24,7 +24,7 @@ const std::vector<KnownExtension>& known_extensions() {
     std::vector<KnownExtension> t = {
         {"EXT_lights_image_based", false, "the image-based light is not used (give --env)"},
         {"EXT_mesh_gpu_instancing", true,
-         "every instance placed, each a copy of the mesh's triangles (no two-level BVH yet)"},
+         "every instance placed: of the mesh in a two-level BVH, or a copy (--instancing)"},
         {"EXT_meshopt_compression", true,
          "buffer views decoded with meshoptimizer (all modes and filters)"},
         {"EXT_texture_avif", false,

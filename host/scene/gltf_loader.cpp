@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -308,6 +309,11 @@ class SceneBuilder {
   SceneBuilder(const tinygltf::Model& model, Scene& scene, int variant)
       : model_(model), scene_(scene), variant_(variant) {}
 
+  // With `instancing`, each mesh is loaded once and its placements are Scene::instances.
+  void set_instancing(bool instancing) { instancing_ = instancing; }
+  // The scene's bounds (Scene::bounds_lo/hi): of its vertices, or of every instance's.
+  void compute_bounds() const;
+
   // What build() will load: the placements and their triangles (gltf_loader.h).
   LoadCounts count(int scene_index) const;
   // Loads the scene; `counts` (from count()) size the triangle arrays once.
@@ -322,6 +328,7 @@ class SceneBuilder {
   bool any_attribute(const char* name) const;
   void visit(int node, const glm::dmat4& world);
   void add_mesh(int mesh, const glm::dmat4& world);
+  void add_instance(int mesh, const glm::dmat4& world);
   void count_placement(int mesh, const std::vector<glm::dmat4>* instances);
   std::uint32_t material_index(int material);
   int primitive_material(const tinygltf::Primitive& p) const;
@@ -336,6 +343,13 @@ class SceneBuilder {
   gltf::VertexNeeds file_needs_;  // the optional arrays: whether the scene keeps them at all
   std::set<std::pair<int, std::size_t>> warned_;  // (mesh, primitive): instances warn once
   std::set<int> placed_;                          // the meshes nodes place (GltfSummary)
+  bool instancing_ = false;
+  // Instancing: each loaded glTF mesh's index in Scene::meshes and its vertices [first, end).
+  struct LoadedMesh {
+    std::uint32_t index;
+    std::size_t first_vertex, end_vertex;
+  };
+  std::map<int, LoadedMesh> loaded_;
 };
 
 // Depth-first, children in order, with an explicit stack: node order defines camera order, and
@@ -399,10 +413,19 @@ bool SceneBuilder::any_attribute(const char* name) const {
 
 LoadCounts SceneBuilder::count(int scene_index) const {
   LoadCounts counts;
+  std::set<int> meshes;
   walk(scene_index, [&](int node, const glm::dmat4&) {
     const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(node)];
-    if (n.mesh >= 0) count_mesh(n.mesh, gltf::placements(model_, n), counts);
+    if (n.mesh < 0) return;
+    const std::uint64_t copies = gltf::placements(model_, n);
+    count_mesh(n.mesh, copies, counts);
+    if (copies == 0 || !meshes.insert(n.mesh).second) return;
+    LoadCounts once;
+    count_mesh(n.mesh, 1, once);
+    counts.mesh_triangles += once.triangles;
+    counts.mesh_max_triangles += once.max_triangles;
   });
+  counts.meshes = meshes.size();
   return counts;
 }
 
@@ -415,8 +438,9 @@ void SceneBuilder::build(int scene_index, const LoadCounts& counts) {
   file_needs_.color0 = any_attribute("COLOR_0");
   // At most max_triangles, each counted from bytes in the file; vertices are counted per
   // primitive as it is loaded (gltf_primitive.cpp).
-  scene_.indices.reserve(3 * counts.max_triangles);
-  scene_.triangle_material.reserve(counts.max_triangles);
+  const std::uint64_t triangles = instancing_ ? counts.mesh_max_triangles : counts.max_triangles;
+  scene_.indices.reserve(3 * triangles);
+  scene_.triangle_material.reserve(triangles);
   walk(scene_index, [this](int node, const glm::dmat4& world) { visit(node, world); });
 }
 
@@ -433,9 +457,9 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
     if (node.mesh >= 0) {
       const auto instances = gltf::instance_transforms(model_, node, node_index);
       if (instances)
-        for (const glm::dmat4& instance : *instances) add_mesh(node.mesh, world * instance);
+        for (const glm::dmat4& instance : *instances) add_instance(node.mesh, world * instance);
       else
-        add_mesh(node.mesh, world);
+        add_instance(node.mesh, world);
       count_placement(node.mesh, instances ? &*instances : nullptr);
     }
     if (node.camera >= 0) scene_.cameras.push_back(gltf::make_camera(model_, node.camera, world));
@@ -446,6 +470,32 @@ void SceneBuilder::visit(int node_index, const glm::dmat4& world) {
   } catch (const Error& e) {
     throw Error(where + e.what());
   }
+}
+
+// One placement of a mesh: a copy in world space, or, with instancing, an instance of the mesh
+// (loaded in its own space the first time). A mesh without triangles places no instance.
+void SceneBuilder::add_instance(int mesh_index, const glm::dmat4& world) {
+  if (!instancing_) {
+    add_mesh(mesh_index, world);
+    return;
+  }
+  auto it = loaded_.find(mesh_index);
+  if (it == loaded_.end()) {
+    const std::size_t first = scene_.triangle_count(), first_vertex = scene_.positions.size();
+    add_mesh(mesh_index, glm::dmat4(1.0));
+    MeshRange range;
+    range.first_triangle = static_cast<std::uint32_t>(first);
+    range.triangle_count = static_cast<std::uint32_t>(scene_.triangle_count() - first);
+    scene_.meshes.push_back(range);
+    const LoadedMesh loaded{static_cast<std::uint32_t>(scene_.meshes.size() - 1), first_vertex,
+                            scene_.positions.size()};
+    it = loaded_.emplace(mesh_index, loaded).first;
+  }
+  if (scene_.meshes[it->second.index].triangle_count == 0) return;
+  Instance instance;
+  instance.to_world = world;
+  instance.mesh = it->second.index;
+  scene_.instances.push_back(instance);
 }
 
 void SceneBuilder::add_mesh(int mesh_index, const glm::dmat4& world) {
@@ -567,20 +617,80 @@ void SceneBuilder::warn_once(int mesh, std::size_t primitive, const std::string&
                             std::to_string(primitive) + ": " + message);
 }
 
-void compute_bounds(Scene& scene) {
+void SceneBuilder::compute_bounds() const {
+  Scene& scene = scene_;
   if (scene.positions.empty()) {  // an empty scene: a point at the origin, not inverted bounds
     scene.bounds_lo = scene.bounds_hi = glm::vec3(0.0f);
     return;
   }
   scene.bounds_lo = glm::vec3(std::numeric_limits<float>::max());
   scene.bounds_hi = glm::vec3(std::numeric_limits<float>::lowest());
-  for (const glm::vec3& p : scene.positions) {
-    scene.bounds_lo = glm::min(scene.bounds_lo, p);
-    scene.bounds_hi = glm::max(scene.bounds_hi, p);
+  if (!instancing_) {
+    for (const glm::vec3& p : scene.positions) {
+      scene.bounds_lo = glm::min(scene.bounds_lo, p);
+      scene.bounds_hi = glm::max(scene.bounds_hi, p);
+    }
+    return;
   }
+  // Every vertex of every instance, as the flattened scene would have them (its loader maps them
+  // in double too), so that the framing camera is the same either way; past kExactBoundsVertices
+  // (a fraction of a second), each instance's box: the mesh's box's corners mapped, which holds
+  // the instance but may be larger.
+  constexpr std::uint64_t kExactBoundsVertices = std::uint64_t(1) << 26;
+  std::vector<const LoadedMesh*> by_index(scene.meshes.size());
+  for (const auto& [mesh, loaded] : loaded_) by_index[loaded.index] = &loaded;
+  std::uint64_t world_vertices = 0;
+  for (const Instance& instance : scene.instances) {
+    const LoadedMesh& m = *by_index[instance.mesh];
+    world_vertices += m.end_vertex - m.first_vertex;
+  }
+  const bool exact = world_vertices <= kExactBoundsVertices;
+  std::vector<std::pair<glm::dvec3, glm::dvec3>> mesh_box(scene.meshes.size());
+  if (!exact)
+    for (std::size_t i = 0; i < mesh_box.size(); ++i) {
+      glm::dvec3 a(std::numeric_limits<double>::max()), b(std::numeric_limits<double>::lowest());
+      for (std::size_t v = by_index[i]->first_vertex; v < by_index[i]->end_vertex; ++v) {
+        a = glm::min(a, glm::dvec3(scene.positions[v]));
+        b = glm::max(b, glm::dvec3(scene.positions[v]));
+      }
+      mesh_box[i] = {a, b};
+    }
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(std::numeric_limits<double>::lowest());
+  const auto add = [&](const glm::dmat4& m, const glm::dvec3& v) {
+    const glm::dvec3 p = glm::dvec3(m * glm::dvec4(v, 1.0));
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  };
+  for (const Instance& instance : scene.instances) {
+    if (exact) {
+      const LoadedMesh& m = *by_index[instance.mesh];
+      for (std::size_t v = m.first_vertex; v < m.end_vertex; ++v)
+        add(instance.to_world, glm::dvec3(scene.positions[v]));
+      continue;
+    }
+    const auto& [a, b] = mesh_box[instance.mesh];
+    for (int c = 0; c < 8; ++c)
+      add(instance.to_world, glm::dvec3(c & 1 ? b.x : a.x, c & 2 ? b.y : a.y, c & 4 ? b.z : a.z));
+  }
+  if (scene.instances.empty()) lo = hi = glm::dvec3(0.0);
+  scene.bounds_lo = glm::vec3(lo);
+  scene.bounds_hi = glm::vec3(hi);
 }
 
 }  // namespace
+
+bool use_instancing(Instancing mode, const LoadCounts& counts) {
+  switch (mode) {
+    case Instancing::kAlways:
+      return true;
+    case Instancing::kNever:
+      return false;
+    case Instancing::kAuto:
+      break;
+  }
+  return counts.max_triangles >= kInstancingGain * counts.mesh_max_triangles &&
+         counts.placements > counts.meshes;
+}
 
 Scene load_gltf(const std::string& path, const LoadOptions& options) {
   Scene scene;
@@ -626,9 +736,12 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
           gltf::convert_material(model, static_cast<int>(i), textures, &clamped));
     for (const std::string& w : clamped) scene.warnings.push_back(path + ": " + w);
     SceneBuilder builder(model, scene, variant);
-    const LoadCounts counts = builder.count(scene_index);
+    LoadCounts counts = builder.count(scene_index);
+    counts.instanced = use_instancing(options.instancing, counts);
     if (options.check_counts) options.check_counts(counts);
+    builder.set_instancing(counts.instanced);
     builder.build(scene_index, counts);
+    builder.compute_bounds();
     // An empty scene is valid glTF (only the background shows); say so, in case it is a mistake.
     if (scene.triangle_count() == 0)
       scene.warnings.push_back(path + ": scene " + std::to_string(scene_index) +
@@ -636,7 +749,6 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
   } catch (const Error& e) {
     throw Error(path + ": " + e.what());
   }
-  compute_bounds(scene);
   return scene;
 }
 

@@ -21,7 +21,26 @@ struct LoadCounts {
   // and fans: n - 2). Only accessors whose data lies in the file count (an accessor without a
   // bufferView, all zeros, counts none: gltf_accessor.h, readable_count).
   std::uint64_t triangles = 0, max_triangles = 0;
+  // The same for each placed mesh once (what an instanced scene holds).
+  std::uint64_t mesh_triangles = 0, mesh_max_triangles = 0;
+  std::uint64_t meshes = 0;  // distinct meshes placed
+  // Whether the scene loads instanced (LoadOptions::instancing for these counts): it then holds
+  // mesh_triangles and a transform per placement, else `triangles`.
+  bool instanced = false;
+  std::uint64_t stored_triangles() const { return instanced ? mesh_triangles : triangles; }
 };
+
+// Whether the loader keeps each mesh once and its placements as instances (Scene::instances).
+enum class Instancing : std::uint8_t {
+  kAuto,    // when the placements hold at least twice the triangles of the meshes they place
+  kAlways,  // whenever a mesh is placed
+  kNever,   // every placement a copy in world space
+};
+// kAuto's rule: instances when the world would hold at least this many times the triangles of
+// the distinct meshes (the memory then at most halves; a scene placing each mesh about once is
+// traversed faster flat: docs/performance.md, "Instancing").
+inline constexpr std::uint64_t kInstancingGain = 2;
+bool use_instancing(Instancing mode, const LoadCounts& counts);
 
 // How to load a file, beyond what it says itself.
 struct LoadOptions {
@@ -36,6 +55,7 @@ struct LoadOptions {
   // wp::Error refuses the scene before the loader allocates for it (the renderer checks them
   // against the device's memory: render.h, check_scene_counts).
   std::function<void(const LoadCounts&)> check_counts;
+  Instancing instancing = Instancing::kAuto;
 };
 
 // Loads the default scene (or scene 0) of a glTF file: the node hierarchy with full transforms,

@@ -172,6 +172,17 @@ struct GltfSummary {
   std::size_t materials = 0;  // in the file (Scene::materials adds glTF's default one if used)
 };
 
+// One mesh of an instanced scene: triangles [first_triangle, first_triangle + triangle_count).
+struct MeshRange {
+  std::uint32_t first_triangle = 0, triangle_count = 0;
+};
+
+// One placement of a mesh in an instanced scene.
+struct Instance {
+  glm::dmat4 to_world{1.0};  // object to world: the node's world transform (x the GPU instance's)
+  std::uint32_t mesh = 0;    // index into Scene::meshes
+};
+
 struct Scene {
   std::string source;  // file the scene came from
   // FNV-1a 64 (fnv1a.h) of the bytes the scene was loaded from: the glTF or GLB file, then the
@@ -200,6 +211,14 @@ struct Scene {
   std::vector<std::uint32_t> indices;            // 3 x triangle_count()
   std::vector<std::uint32_t> triangle_material;  // triangle_count()
 
+  // Instancing. Empty `instances`: the arrays above are the world, every placement of a mesh a
+  // copy in world space. Otherwise (LoadOptions::instancing) they hold each placed mesh once, in
+  // its own space, mesh i being the triangles of meshes[i], and the world is every instance's
+  // mesh placed by its transform (rendered through a two-level BVH: bvh.h, build_two_level).
+  // Either way a triangle's material and winding are the file's.
+  std::vector<MeshRange> meshes;
+  std::vector<Instance> instances;
+
   std::vector<Material> materials;  // never empty: the loader adds glTF's default material if used
   std::vector<Image> images;
   std::vector<TextureRef> textures;
@@ -212,6 +231,15 @@ struct Scene {
   GltfSummary gltf;
 
   std::size_t triangle_count() const { return indices.size() / 3; }
+  // Triangles in the world: triangle_count(), or each instance's mesh's count summed.
+  std::uint64_t world_triangle_count() const;
 };
+
+inline std::uint64_t Scene::world_triangle_count() const {
+  if (instances.empty()) return triangle_count();
+  std::uint64_t n = 0;
+  for (const Instance& i : instances) n += meshes[i.mesh].triangle_count;
+  return n;
+}
 
 }  // namespace wp

@@ -18,10 +18,14 @@ WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch laun
   const TraceRay ray = trace_ray(path_ray_origin(paths, slot), path_ray_dir(paths, slot),
                                  path_ray_tmin(paths, slot), key);
   TraceHit hit;
-  if (bvh_trace(scene, &ray, INFINITY, &hit, false))
+  if (bvh_trace(scene, &ray, INFINITY, &hit, false)) {
     path_store_hit(paths, slot, hit.t, hit.u, hit.v, hit.tri);
-  else
+#if WP_BVH_INSTANCES
+    path_set_hit_instance(paths, slot, hit.inst);
+#endif
+  } else {
     path_store_hit(paths, slot, INFINITY, 0.0f, 0.0f, 0u);
+  }
 }
 
 #endif /* WP_INTEGRATOR_INTERSECT_CLOSEST_H */

@@ -52,20 +52,21 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
 #endif
     return false;
   }
-  const uint tri = path_hit_triangle(paths, slot);
-  const uint4 tv = scene->tri_vertices[tri];
+  const uint tri = path_hit_triangle(paths, slot), inst = path_hit_instance(paths, slot);
+  const uint4 tv = scene->tri_vertices[tri]; /* the file's winding: emission reads it */
+  (void)tv;
   bool front;
 #if WP_FEATURE_TEXTURE_LOD
   /* The ray cone across the hit, and bent by the surface's curvature for the ray that leaves it
    * (ray_cone.h; sample_next_ray adds the lobe's spread). */
   const float2 cone = path_cone(paths, slot);
   const float width = cone_width_at(cone, t);
-  *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, width,
-                       &front);
+  *s = resolve_surface(scene, inst, tri, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d,
+                       width, &front);
   path_set_cone(paths, slot, (float2)(width, cone_spread_curved(cone.y, s->curvature, width)));
 #else
-  *s = resolve_surface(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d, 0.0f,
-                       &front);
+  *s = resolve_surface(scene, inst, tri, path_hit_u(paths, slot), path_hit_v(paths, slot), ray_d,
+                       0.0f, &front);
 #endif
 #if WP_FEATURE_DISPERSION
   s->channel = (path_flags(paths, slot) & WP_PATH_CHANNEL_MASK) >> WP_PATH_CHANNEL_SHIFT;
@@ -91,7 +92,7 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
     if (max3(le) > 0.0f) {
       /* Seen from the vertex that sampled the ray: panes passed on the way add their distance. */
       const float dist = t + path_pane_distance(paths, slot);
-      const float p_light = triangle_light_pdf(scene, tri, dist, dot(s->ng, ray_d));
+      const float p_light = triangle_light_pdf(scene, inst, tri, dist, dot(s->ng, ray_d));
       path_set_radiance(
           paths, slot,
           path_radiance(paths, slot) + beta * le * mis_weight_bsdf_hit(bsdf_pdf, p_light));

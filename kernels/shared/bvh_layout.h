@@ -78,6 +78,26 @@ typedef struct TriBlock4 {
   uint4 flags;
 } TriBlock4;
 
+/* Two-level BVH (scenes that place meshes more than once: host/accel/two_level.h). The node array
+ * holds the top-level tree first (node 0 its root), then each distinct mesh's tree, in the layout
+ * above, with node and triangle references already offset into the shared arrays. The top-level
+ * tree's leaves reference instances instead of triangles, through the instance reference array
+ * (uint): binary, a leaf ~ref with count n references entries [~ref, ~ref + n); wide, a leaf c
+ * references the 4 x ((c & 3) + 1) entries from 4 x (c >> 2), unused ones WP_NO_INSTANCE. Each
+ * entry is an index into the instance array. A ray reaching an instance continues in its mesh's
+ * tree (root node BvhInstance.meta.x) with its origin and direction mapped into the mesh's space
+ * by to_object; the direction is not renormalised, so distances along the ray are the same in
+ * both spaces. */
+#define WP_NO_INSTANCE 0xffffffffu
+#define WP_INSTANCE_MIRROR 1u /* the transform's determinant is negative (BvhInstance.meta.z) */
+
+typedef struct BvhInstance {
+  float4 to_object[3]; /* rows of the world-to-object affine map: x' = dot(row.xyz, x) + row.w */
+  float4 to_world[3];  /* rows of the object-to-world affine map */
+  uint4 meta; /* x: the mesh's root node; y: the light of the mesh's first emissive triangle here,
+                 or WP_NO_LIGHT (host/lights/light_table.h); z: WP_INSTANCE_* flags; w: mesh */
+} BvhInstance;
+
 typedef struct IsectTri {
   float4 v0; /* xyz: vertex 0; w: scene triangle index (bits of a uint) */
   float4 v1; /* xyz: vertex 1; w: WP_TRI_* flags (bits of a uint) */

@@ -111,7 +111,8 @@ typedef struct Light {
   float4 intensity; /* point, spot: W/sr; directional: W/m^2 (rgb). Triangles and the environment
                        take their radiance from the material and the map. */
   float4 spot;      /* spot: x angle scale, y angle offset (KHR_lights_punctual falloff) */
-  uint4 meta;       /* x: WP_LIGHT_* type; y: scene triangle index (WP_LIGHT_TRIANGLE) */
+  uint4 meta;       /* x: WP_LIGHT_* type; y: scene triangle index (WP_LIGHT_TRIANGLE); z: its
+                       instance in a two-level BVH (bvh_layout.h), else WP_NO_INSTANCE */
 } Light;
 
 /* One entry of the alias table that picks a light: keep `index` with probability `prob`, else
@@ -161,7 +162,9 @@ typedef struct SceneDesc {
   uint texels;       /* uint[] RGBA8 */
   uint lights;       /* Light[] */
   uint light_alias;  /* LightAlias[light_count] */
-  uint tri_light;    /* uint[] per scene triangle: its index in lights[], or WP_NO_LIGHT */
+  uint tri_light;    /* uint[] per scene triangle: its index in lights[], or WP_NO_LIGHT; in an
+                       instanced scene its index among its mesh's emissive triangles, the light
+                       being that plus the instance's first (BvhInstance.meta.y) */
   uint env_texels;   /* float4[] env_width x env_height, linear RGB radiance, rows from +Y down */
   uint env_marginal; /* environment sampling tables (kernels/environment.h) */
   uint env_conditional;
@@ -169,7 +172,11 @@ typedef struct SceneDesc {
   uint light_count;
   uint env_light; /* index of the WP_LIGHT_ENVIRONMENT light, or WP_NO_LIGHT */
   uint triangle_count;
-  uint pad0, pad1, pad2;
+  /* Two-level BVHs only (bvh_layout.h; arrays after the environment's, which are then always
+   * there, maybe empty): */
+  uint instances;     /* BvhInstance[] */
+  uint instance_refs; /* uint[]: the top-level tree's leaves, indices into instances[] */
+  uint pad0;
 } SceneDesc;
 
 /* Byte offset of every path-state field in the path buffer, and the number of path slots. */

@@ -45,8 +45,9 @@ TEST(GltfLoader, ExtensionWarnings) {
   EXPECT_TRUE(s.images.empty());
 }
 
-// GltfSummary: mesh 0 placed by two nodes (one with 3 EXT_mesh_gpu_instancing instances, each a
-// copy), mesh 1 by none, a third node with no mesh; the file's lists as it has them.
+// GltfSummary: mesh 0 placed by two nodes (one with 3 EXT_mesh_gpu_instancing instances), mesh 1
+// by none, a third node with no mesh; the file's lists as it has them. Four placements of one
+// triangle load instanced by default (LoadOptions::instancing, kAuto).
 TEST(GltfLoader, Summary) {
   Gltf g = one_triangle("");
   g.mesh({prim({{"POSITION", 0}})});
@@ -58,7 +59,9 @@ TEST(GltfLoader, Summary) {
   g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing","KHR_texture_transform"],)"
           R"("extensionsRequired":["KHR_texture_transform"])";
   const wp::Scene s = wp::load_gltf(g.write("summary.gltf"));
-  EXPECT_EQ(s.triangle_count(), 1u + 3u);
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_EQ(s.instances.size(), 1u + 3u);
+  EXPECT_EQ(s.world_triangle_count(), 1u + 3u);
   EXPECT_EQ(s.gltf.meshes, 2u);
   EXPECT_EQ(s.gltf.meshes_placed, 1u);
   EXPECT_EQ(s.gltf.mesh_nodes, 2u);
@@ -75,6 +78,7 @@ TEST(GltfLoader, Summary) {
 // (the extension's order), with ROTATION as normalized shorts and a mirroring SCALE among them:
 // each instance's corners against that product in double, its winding kept counter-clockwise
 // (the face normal is the transformed one's direction), and the counts before loading multiplied.
+// Flattened (each instance a copy), and instanced (each instance that product, the mesh once).
 TEST(GltfLoader, GpuInstancesArePlaced) {
   Gltf g;
   const int pos = g.vec3s({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
@@ -92,9 +96,15 @@ TEST(GltfLoader, GpuInstancesArePlaced) {
          true);
   g.top = R"("extensionsUsed":["EXT_mesh_gpu_instancing"])";
   wp::LoadOptions options;
+  options.instancing = wp::Instancing::kNever;
   std::uint64_t counted = 0;
   options.check_counts = [&](const wp::LoadCounts& c) { counted = c.placements; };
-  const wp::Scene s = wp::load_gltf(g.write("instances.gltf"), options);
+  const std::string path = g.write("instances.gltf");
+  const wp::Scene s = wp::load_gltf(path, options);
+  options.instancing = wp::Instancing::kAlways;
+  const wp::Scene instanced = wp::load_gltf(path, options);
+  ASSERT_EQ(instanced.triangle_count(), 1u);
+  ASSERT_EQ(instanced.instances.size(), 3u);
   check_invariants(s);
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(counted, 3u);
@@ -116,6 +126,9 @@ TEST(GltfLoader, GpuInstancesArePlaced) {
   for (std::size_t i = 0; i < 3; ++i) {
     SCOPED_TRACE(i);
     const glm::dmat4 m = node * instances[i];
+    for (int col = 0; col < 4; ++col)
+      for (int row = 0; row < 4; ++row)
+        EXPECT_NEAR(instanced.instances[i].to_world[col][row], m[col][row], 1e-12);
     // A mirrored triangle has two corners swapped (winding kept): compare the corners as a set.
     std::vector<vec3> got;
     for (int c = 0; c < 3; ++c) got.push_back(corner(s, i, c));
@@ -179,13 +192,20 @@ TEST(GltfLoader, CountsBeforeLoading) {
   g.node(R"("translation":[0,0,5])", true);  // no mesh
   std::vector<wp::LoadCounts> seen;
   wp::LoadOptions options;
+  options.instancing = wp::Instancing::kNever;
   options.check_counts = [&](const wp::LoadCounts& c) { seen.push_back(c); };
   const wp::Scene s = wp::load_gltf(g.write("counts.gltf"), options);
   ASSERT_EQ(seen.size(), 1u);
   EXPECT_EQ(seen[0].placements, 4u);
   EXPECT_EQ(seen[0].triangles, 4u);           // 2 x 2 from the lists
   EXPECT_EQ(seen[0].max_triangles, 4u + 6u);  // and up to 2 x (5 - 2) from the strips
-  EXPECT_EQ(s.triangle_count(), 10u);         // this strip has no degenerate triangle
+  EXPECT_EQ(seen[0].meshes, 2u);              // each mesh once: what an instanced load holds
+  EXPECT_EQ(seen[0].mesh_triangles, 2u);
+  EXPECT_EQ(seen[0].mesh_max_triangles, 2u + 3u);
+  EXPECT_FALSE(seen[0].instanced);
+  // kAuto instances them: the copies would hold twice the meshes' triangles.
+  EXPECT_TRUE(wp::use_instancing(wp::Instancing::kAuto, seen[0]));
+  EXPECT_EQ(s.triangle_count(), 10u);  // this strip has no degenerate triangle
   EXPECT_GE(s.triangle_count(), seen[0].triangles);
   EXPECT_LE(s.triangle_count(), seen[0].max_triangles);
 

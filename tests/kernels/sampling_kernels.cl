@@ -148,7 +148,7 @@ inline float triangle_pdf(const SceneView* scene, float3 p, float3 d) {
   const float cos_light = -dot(n, d);
   const bool two_sided = scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED;
   if (!(cos_light > 0.0f || (two_sided && cos_light < 0.0f))) return 0.0f;
-  return triangle_light_pdf(scene, 0u, t, cos_light);
+  return triangle_light_pdf(scene, WP_NO_INSTANCE, 0u, t, cos_light);
 }
 
 /* The density the routine under test assigns to local direction l (the eval side). */
@@ -269,7 +269,7 @@ inline void draw_other(const Config* c, const SceneView* scene, float2 u, float4
     l = 2.0f * dot(v, h) * h - v;
     pdf = ggx_reflection_pdf(v.z, h.z, h.x * h.x + h.y * h.y, c->a.w);
   } else {
-    const LightSample ls = sample_triangle(scene, 0u, c->a.xyz, u);
+    const LightSample ls = sample_triangle(scene, WP_NO_INSTANCE, 0u, c->a.xyz, u);
     l = ls.wi;
     pdf = ls.pdf;
     check->z = pdf > 0.0f ? rel_error(ls.dist, triangle_hit(scene, c->a.xyz, l)) : 0.0f;

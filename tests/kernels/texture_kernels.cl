@@ -52,7 +52,8 @@ __kernel void resolve_surfaces(WP_SCENE_PARAMS, __global const float4* queries,
   const float4 q = queries[i];
   const uint4 tv = scene.tri_vertices[as_uint(q.x)];
   bool front;
-  const Surface s = resolve_surface(&scene, tv, q.y, q.z, rays[i].xyz, 0.0f, &front);
+  const Surface s =
+      resolve_surface(&scene, WP_NO_INSTANCE, as_uint(q.x), q.y, q.z, rays[i].xyz, 0.0f, &front);
   out[4 * i] = (float4)(s.ns, front ? 1.0f : 0.0f);
   out[4 * i + 1] = (float4)(s.color, s.metallic);
   out[4 * i + 2] = (float4)(s.roughness, s.transmission, 0.0f, 0.0f);

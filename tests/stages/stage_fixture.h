@@ -100,9 +100,11 @@ struct Field {
 #define WP_PATH_FIELD(type, name, description) Field{#name, &wp::dev::PathLayout::name},
 #define WP_PATH_AOV_FIELD(type, name, description)
 #define WP_PATH_OPT_FIELD(features, type, name, description)
+#define WP_PATH_INSTANCE_FIELD(type, name, description)
 const Field kFields[] = {
 #include "kernels/shared/path_state.def"
 };
+#undef WP_PATH_INSTANCE_FIELD
 #undef WP_PATH_OPT_FIELD
 #undef WP_PATH_AOV_FIELD
 #undef WP_PATH_FIELD
