@@ -10,6 +10,7 @@
 // the image its flattened load renders, within the standard error, for both BVH layouts: smooth
 // spheres stretched, rotated and mirrored, emissive quads placed three times (three lights, one
 // mirrored), see-through (alpha BLEND) quads, one of them mirrored.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -19,6 +20,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "host/accel/bvh_input.h"
+#include "host/device/device_scene.h"
 #include "host/render/render.h"
 #include "tests/device_test.h"
 #include "tests/gltf/compress_twin.h"
@@ -205,6 +208,38 @@ TEST_F(InstancesRender, InstancedSceneRendersItsFlattenedImage) {
     EXPECT_EQ(ra.report.nonfinite_samples, 0u);
     expect_same_estimate(ra, rb, "instanced vs flattened");
     expect_same_pixels(ra, rb, "instanced vs flattened");
+  }
+}
+
+// The instanced scene split over several scene buffers (the instance arrays among them) renders
+// bit for bit as in one, and with AOVs its image is the same: both as for flattened scenes
+// (PackedSize.SplitSceneRendersExactlyAsOne, Aov tests).
+TEST_F(InstancesRender, InstancedSceneSplitsOverBuffersAndKeepsItsImageWithAovs) {
+  LoadOptions on;
+  on.instancing = Instancing::kAlways;
+  const Scene a = load_gltf(instanced_scene(), on);
+  for (const int width : {2, 8}) {
+    SCOPED_TRACE("BVH width " + std::to_string(width));
+    RenderSettings s = twin_settings(32, 24, 4, 4, 0.05f);
+    s.bvh_width = width;
+    const Rendered one = render(*runtime_, a, s);
+    bvh::BuildOptions o;
+    o.width = width;
+    const bvh::Bvh b = build_scene_bvh(a, o, std::string());
+    const SceneCounts c = scene_counts(a, nullptr);
+    // Buffers as small as the largest array: the arrays spread over several, the instances'
+    // (the last two) away from the first.
+    const SceneLayout whole = scene_layout(c, bvh_bytes(b), kSceneBufferReach);
+    const std::uint64_t largest = *std::max_element(whole.sizes.begin(), whole.sizes.end());
+    s.scene_buffer_bytes = (largest + 63) / 64 * 64;
+    const SceneLayout split = scene_layout(c, bvh_bytes(b), s.scene_buffer_bytes);
+    ASSERT_GE(split.buffer_bytes.size(), 3u);
+    ASSERT_EQ(split.places.size(), 20u);
+    EXPECT_GT(split.places[18].buffer, 0);
+    EXPECT_EQ(render(*runtime_, a, s).image.rgb, one.image.rgb);
+    s.scene_buffer_bytes = 0;
+    s.aov = true;
+    EXPECT_EQ(render(*runtime_, a, s).image.rgb, one.image.rgb);
   }
 }
 
