@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <limits>
+#include <set>
 #include <memory>
 #include <utility>
 
@@ -153,6 +154,140 @@ std::pair<const unsigned char*, std::size_t> view_bytes(const tinygltf::Model& m
   return {data.data() + v.byteOffset, v.byteLength};
 }
 
+// Reads the Draco bitstream's header (the Draco bitstream specification, version 2.2: header,
+// metadata, connectivity) up to the counts the decoder allocates from.
+class HeaderReader {
+ public:
+  HeaderReader(const unsigned char* data, std::size_t size, std::string at)
+      : p_(data), end_(data + size), at_(std::move(at)) {}
+
+  std::uint32_t u8() {
+    need(1);
+    return *p_++;
+  }
+  std::uint32_t u16() {
+    const std::uint32_t lo = u8();
+    return lo | u8() << 8;
+  }
+  std::uint32_t var_u32() {  // LEB128, at most 5 bytes
+    std::uint64_t v = 0;
+    for (int shift = 0; shift < 35; shift += 7) {
+      const std::uint32_t b = u8();
+      v |= std::uint64_t(b & 0x7f) << shift;
+      if (!(b & 0x80)) {
+        if (v > std::numeric_limits<std::uint32_t>::max()) break;
+        return static_cast<std::uint32_t>(v);
+      }
+    }
+    throw Error(at_ + ": a malformed number in the Draco header");
+  }
+  void skip(std::size_t n) {
+    need(n);
+    p_ += n;
+  }
+  // DecodeMetadataElement: its entries, then its sub-elements, nested at most kMaxDepth deep.
+  void metadata_element(int depth) {
+    constexpr int kMaxDepth = 32;
+    if (depth > kMaxDepth) throw Error(at_ + ": Draco metadata nested too deep");
+    for (std::uint32_t n = var_u32(); n > 0; --n) {
+      skip(u8());  // key
+      skip(u8());  // value
+    }
+    for (std::uint32_t n = var_u32(); n > 0; --n) {
+      skip(u8());  // sub-metadata key
+      metadata_element(depth + 1);
+    }
+  }
+  const std::string& at() const { return at_; }
+
+ private:
+  void need(std::size_t n) {
+    if (static_cast<std::size_t>(end_ - p_) < n) throw Error(at_ + ": the Draco data end early");
+  }
+  const unsigned char* p_;
+  const unsigned char* end_;
+  std::string at_;
+};
+
+// What the header of a Draco mesh announces, before anything is decoded.
+struct DracoCounts {
+  std::uint64_t faces = 0;
+  // Sequential encoding: its points; edgebreaker: its encoded vertices (the points before any
+  // attribute seam splits them).
+  std::uint64_t points = 0;
+};
+
+DracoCounts read_draco_header(const unsigned char* data, std::size_t size, const std::string& at) {
+  HeaderReader r(data, size, at);
+  static const unsigned char kMagic[5] = {'D', 'R', 'A', 'C', 'O'};
+  for (const unsigned char c : kMagic)
+    if (r.u8() != c) throw Error(at + ": not Draco data (no DRACO signature)");
+  const std::uint32_t major = r.u8(), minor = r.u8();
+  // The extension specifies Draco bitstream 2.2; older streams lay the counts out differently.
+  if (major != 2 || minor != 2)
+    throw Error(at + ": Draco bitstream version " + std::to_string(major) + "." +
+                std::to_string(minor) + " (KHR_draco_mesh_compression uses 2.2)");
+  if (r.u8() != 1) throw Error(at + ": not a Draco triangle mesh");
+  const std::uint32_t method = r.u8();
+  const std::uint32_t flags = r.u16();
+  if (flags & 0x8000) {  // metadata: per attribute, then the file's
+    for (std::uint32_t n = r.var_u32(); n > 0; --n) {
+      r.var_u32();  // the attribute's id
+      r.metadata_element(0);
+    }
+    r.metadata_element(0);
+  }
+  DracoCounts h;
+  if (method == 0) {  // sequential
+    h.faces = r.var_u32();
+    h.points = r.var_u32();
+  } else if (method == 1) {  // edgebreaker
+    r.u8();                  // traversal type
+    h.points = r.var_u32();  // encoded vertices
+    h.faces = r.var_u32();
+  } else {
+    throw Error(at + ": Draco encoder method " + std::to_string(method) + " is not 0 or 1");
+  }
+  return h;
+}
+
+// The counts the header of a primitive's Draco data announces, against what its accessors claim
+// (which the loader has counted against the device's memory before decoding: gltf_loader.cpp):
+// no more faces than its indices give triangles, no more points than any of its attributes has,
+// and no more points than its faces' corners. Draco allocates from these counts before it has
+// decoded anything (a 232-byte payload of the fuzzer's asked for 2.56 GB); checked here, what it
+// allocates is bounded by what the file claims and the loader accepted.
+void check_draco_header(const tinygltf::Model& model, const tinygltf::Primitive& p,
+                        const tinygltf::Value& ext, const unsigned char* data, std::size_t size,
+                        const std::string& where) {
+  const std::string at = where;
+  const DracoCounts h = read_draco_header(data, size, at);
+  const auto position = p.attributes.find("POSITION");
+  const std::uint64_t corners = p.indices >= 0 ? accessor(model, p.indices, at).count
+                                : position != p.attributes.end()
+                                    ? accessor(model, position->second, at).count
+                                    : 0;
+  // A strip of n indices has n - 2 triangles: at most n faces either way.
+  const std::uint64_t max_faces = p.mode == TINYGLTF_MODE_TRIANGLE_STRIP ? corners : corners / 3;
+  if (h.faces > max_faces)
+    throw Error(at + ": the Draco header announces " + std::to_string(h.faces) +
+                " faces, more than the primitive's accessors hold (" + std::to_string(max_faces) +
+                ")");
+  if (h.points > 3 * h.faces)
+    throw Error(at + ": the Draco header announces " + std::to_string(h.points) +
+                " points, more than its " + std::to_string(h.faces) + " faces use");
+  const tinygltf::Value& attributes = ext.Get("attributes");
+  for (const std::string& name : attributes.Keys()) {
+    const auto attribute = p.attributes.find(name);
+    if (attribute == p.attributes.end()) continue;  // an error once decoded
+    const std::uint64_t count = accessor(model, attribute->second, at).count;
+    if (h.points > count)
+      throw Error(at + ": the Draco header announces " + std::to_string(h.points) +
+                  " points, more than accessor " + std::to_string(attribute->second) + " (" +
+                  name.substr(0, 32) + ") holds (" + std::to_string(count) + ")");
+  }
+}
+
 // One Draco primitive: its extension read, its mesh decoded (once per bufferView, in `decoded`),
 // its accessors given the data.
 void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const tinygltf::Value& ext,
@@ -167,6 +302,7 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const tiny
   auto it = decoded.find(view);
   if (it == decoded.end()) {
     const auto [data, size] = view_bytes(model, view, where);
+    check_draco_header(model, p, ext, data, size, where);
     it = decoded.emplace(view, decode_draco_mesh(data, size, where)).first;
   }
   const DracoMesh& mesh = it->second;
@@ -257,10 +393,12 @@ DracoMesh decode_draco_mesh(const unsigned char* data, std::size_t size, const s
   return out;
 }
 
-void decode_draco(tinygltf::Model& model) {
+void decode_draco(tinygltf::Model& model, const std::set<int>& meshes) {
   std::map<std::uint64_t, DracoMesh> decoded;  // by bufferView
   Writer writer(model);
-  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+  for (const int index : meshes) {
+    if (index < 0 || static_cast<std::size_t>(index) >= model.meshes.size()) continue;
+    const auto m = static_cast<std::size_t>(index);
     for (std::size_t i = 0; i < model.meshes[m].primitives.size(); ++i) {
       tinygltf::Primitive& p = model.meshes[m].primitives[i];
       const std::string where = "mesh " + std::to_string(m) + " primitive " + std::to_string(i);

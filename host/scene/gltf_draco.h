@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,11 +39,16 @@ struct DracoMesh {
 // attribute mapping outside the mesh, or an attribute of a type glTF has not (64-bit, bool).
 DracoMesh decode_draco_mesh(const unsigned char* data, std::size_t size, const std::string& where);
 
-// Decodes every primitive's KHR_draco_mesh_compression and points its accessors at the decoded
-// data (primitives of TRIANGLE_STRIP mode become TRIANGLES: Draco stores faces). Throws wp::Error
-// naming the mesh and primitive for a malformed extension, an attribute it lists that the
-// primitive has not or the data has not, an accessor whose count, component count or use disagrees
-// with the decoded mesh, and the errors of decode_draco_mesh.
-void decode_draco(tinygltf::Model& model);
+// Decodes the KHR_draco_mesh_compression of every primitive of `meshes` (the meshes the scene
+// places; others are never read) and points its accessors at the decoded data (primitives of
+// TRIANGLE_STRIP mode become TRIANGLES: Draco stores faces). Before Draco decodes anything, the
+// counts its header announces are checked against the primitive's accessors (the Draco bitstream
+// must be version 2.2, the extension's): Draco allocates from them, so the loader counts the
+// accessors' claims against the device before calling this (gltf_loader.cpp). Throws wp::Error
+// naming the mesh and primitive for a malformed extension, a header announcing more faces or
+// points than the accessors hold (or more points than its faces' corners), an attribute it lists
+// that the primitive has not or the data has not, an accessor whose count, component count or use
+// disagrees with the decoded mesh, and the errors of decode_draco_mesh.
+void decode_draco(tinygltf::Model& model, const std::set<int>& meshes);
 
 }  // namespace wp::gltf

@@ -314,8 +314,9 @@ class SceneBuilder {
   // The scene's bounds (Scene::bounds_lo/hi): of its vertices, or of every instance's.
   void compute_bounds() const;
 
-  // What build() will load: the placements and their triangles (gltf_loader.h).
-  LoadCounts count(int scene_index) const;
+  // What build() will load: the placements and their triangles (gltf_loader.h); `meshes`, when
+  // given, receives the meshes placed.
+  LoadCounts count(int scene_index, std::set<int>* meshes = nullptr) const;
   // Loads the scene; `counts` (from count()) size the triangle arrays once.
   void build(int scene_index, const LoadCounts& counts);
 
@@ -392,9 +393,20 @@ void SceneBuilder::count_mesh(int mesh, std::uint64_t copies, LoadCounts& counts
   for (const tinygltf::Primitive& p : model_.meshes[static_cast<std::size_t>(mesh)].primitives) {
     const auto position = p.attributes.find("POSITION");
     if (!gltf::is_triangle_mode(p.mode) || position == p.attributes.end()) continue;
+    const int counted = p.indices >= 0 ? p.indices : position->second;
+    // A Draco primitive's accessors hold no data until it is decoded, which happens only after
+    // these counts are accepted: what they claim counts (its header must agree: gltf_draco.h).
+    const bool draco = p.extensions.count("KHR_draco_mesh_compression") != 0;
     const std::uint64_t n =
-        gltf::readable_count(model_, p.indices >= 0 ? p.indices : position->second);
-    if (p.mode < 0 || p.mode == TINYGLTF_MODE_TRIANGLES) {
+        draco && counted >= 0 && static_cast<std::size_t>(counted) < model_.accessors.size()
+            ? model_.accessors[static_cast<std::size_t>(counted)].count
+            : gltf::readable_count(model_, counted);
+    if (draco && p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      // Draco decodes faces, at most n of them for a strip of n (gltf_draco.cpp): all counted,
+      // as they are allocated whatever they turn out to be.
+      counts.triangles += copies * n;
+      counts.max_triangles += copies * n;
+    } else if (p.mode < 0 || p.mode == TINYGLTF_MODE_TRIANGLES) {
       counts.triangles += copies * (n / 3);
       counts.max_triangles += copies * (n / 3);
     } else if (n >= 3) {
@@ -411,7 +423,7 @@ bool SceneBuilder::any_attribute(const char* name) const {
   return false;
 }
 
-LoadCounts SceneBuilder::count(int scene_index) const {
+LoadCounts SceneBuilder::count(int scene_index, std::set<int>* placed) const {
   LoadCounts counts;
   std::set<int> meshes;
   walk(scene_index, [&](int node, const glm::dmat4&) {
@@ -426,6 +438,7 @@ LoadCounts SceneBuilder::count(int scene_index) const {
     counts.mesh_max_triangles += once.max_triangles;
   });
   counts.meshes = meshes.size();
+  if (placed) *placed = std::move(meshes);
   return counts;
 }
 
@@ -716,9 +729,9 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
       throw Error("asset.version \"" + model.asset.version.substr(0, 32) +
                   "\" is not 2.x (only glTF 2.0 is supported)");
     if (model.scenes.empty()) throw Error("the file has no scenes");
-    // Compressed data first: everything below reads the decoded bytes as uncompressed ones.
+    // Compressed data first: everything below reads the decoded bytes as uncompressed ones (Draco
+    // meshes once the counts are accepted, below).
     gltf::decode_meshopt(model, placeholders);
-    gltf::decode_draco(model);
     const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (static_cast<std::size_t>(scene_index) >= model.scenes.size())
       throw Error("default scene " + std::to_string(scene_index) + " does not exist");
@@ -736,9 +749,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
           gltf::convert_material(model, static_cast<int>(i), textures, &clamped));
     for (const std::string& w : clamped) scene.warnings.push_back(path + ": " + w);
     SceneBuilder builder(model, scene, variant);
-    LoadCounts counts = builder.count(scene_index);
+    std::set<int> placed;
+    LoadCounts counts = builder.count(scene_index, &placed);
     counts.instanced = use_instancing(options.instancing, counts);
     if (options.check_counts) options.check_counts(counts);
+    gltf::decode_draco(model, placed);
     builder.set_instancing(counts.instanced);
     builder.build(scene_index, counts);
     builder.compute_bounds();

@@ -152,7 +152,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (file.empty()) return 0;
   const std::string path = wp::fuzz::write_input(file.data(), file.size(), ".glb");
   try {
-    const wp::Scene scene = wp::load_gltf(path);
+    const wp::Scene scene = wp::load_gltf(path, wp::fuzz::load_options());
     if (verbose) std::fprintf(stderr, "loaded: %zu triangles\n", scene.triangle_count());
   } catch (const wp::Error& e) {
     if (verbose) std::fprintf(stderr, "wp::Error: %s\n", e.what());

@@ -78,7 +78,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const bool glb = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
   const std::string path = wp::fuzz::write_input(data, size, glb ? ".glb" : ".gltf");
   try {
-    const wp::Scene scene = wp::load_gltf(path);
+    const wp::Scene scene = wp::load_gltf(path, wp::fuzz::load_options());
     check_scene(scene);
     (void)wp::framing_camera(scene, 1.5f);
     if (verbose) std::fprintf(stderr, "loaded: %zu triangles\n", scene.triangle_count());

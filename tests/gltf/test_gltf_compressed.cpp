@@ -279,6 +279,61 @@ std::size_t draco_view(const json& d) {
   return d["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["bufferView"];
 }
 
+// The Draco header's counts are checked before Draco decodes (Draco allocates from them: a fuzzed
+// 232-byte payload of version 1.1 asked for 2.56 GB): the bitstream version the extension
+// specifies (2.2), no more faces than the indices accessor holds triangles, no more points than
+// the attributes' accessors or the faces' corners. The header (the Draco bitstream specification):
+// "DRACO", major, minor, encoder type, method (0 sequential: faces, points as varints at 11 and
+// 12; 1 edgebreaker: traversal type at 11, encoded vertices, faces), 2 bytes of flags. The quad's
+// counts (4 points, 2 faces) take one byte each.
+TEST(CompressedEdges, DracoHeaderCountsAreCheckedBeforeDecoding) {
+  const Glb m = draco_twin(quad(), DracoBits{});
+  const json doc = json::parse(m.json);
+  const std::size_t at = doc["bufferViews"][draco_view(doc)]["byteOffset"];
+  ASSERT_EQ(std::string(m.bin.begin() + long(at), m.bin.begin() + long(at) + 5), "DRACO");
+  const int method = m.bin[at + 8];
+  ASSERT_TRUE(method == 0 || method == 1) << method;
+  const std::size_t faces = at + (method == 0 ? 11 : 13), points = at + (method == 0 ? 12 : 12);
+  ASSERT_EQ(m.bin[faces], 2);
+  ASSERT_EQ(m.bin[points], 4);
+  const auto patch = [&](const char* name, std::size_t byte, unsigned char value) {
+    return broken(
+        m, name, [](json&) {},
+        [=](std::vector<unsigned char>& bin, const json&) { bin[byte] = value; });
+  };
+  expect_error(patch("dr_v11.glb", at + 5, 1), "Draco bitstream version 1.2");
+  expect_error(patch("dr_faces.glb", faces, 0x7f), "announces 127 faces, more than");
+  expect_error(patch("dr_points.glb", points, 5), "announces 5 points, more than accessor");
+  expect_error(patch("dr_magic.glb", at, 'X'), "no DRACO signature");
+}
+
+// A Draco primitive's accessors hold no data before it is decoded: what they claim is counted
+// before anything is decoded, so a scene claiming more than the device holds is refused first
+// (check_counts throws) and Draco never sees it.
+TEST(CompressedEdges, DracoClaimsAreCountedBeforeDecoding) {
+  const Glb m = draco_twin(quad(), DracoBits{});
+  const std::string path = broken(m, "dr_claim.glb", [](json& d) {
+    const std::size_t a = d["meshes"][0]["primitives"][0]["indices"];
+    d["accessors"][a]["count"] = 3000000000u;
+  });
+  wp::LoadOptions options;
+  std::uint64_t seen = 0;
+  options.check_counts = [&](const wp::LoadCounts& c) {
+    seen = c.stored_triangles();
+    throw wp::Error("refused from its counts");
+  };
+  try {
+    wp::load_gltf(path, options);
+    ADD_FAILURE() << "loaded";
+  } catch (const wp::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("refused from its counts"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(seen, 1000000000u);
+  // Accepted (no check), the header's 2 faces are within the claim; the decoded mesh then
+  // differs from it.
+  expect_error(path, "differs from the decoded 6");
+}
+
 TEST(CompressedEdges, DracoDataThatLies) {
   const Glb m = draco_twin(quad(), DracoBits{});
   expect_error(broken(m, "dr_trunc.glb",
