@@ -142,7 +142,10 @@ Bvh build_two_level(std::vector<Bvh> meshes, const std::vector<std::uint32_t>& f
 
   BuildOptions top_options = options;
   top_options.spatial_splits = false;  // the boxes are the primitives
-  top_options.max_leaf_size = 1;       // one instance a leaf: each costs a tree of its own
+  // Up to 4 instances a leaf (one block of the wide layout): with 112 bytes a BvhInstance, 4 a
+  // reference and the top-level nodes, 132 bytes an instance at width 8 and 165 at width 2 (220
+  // and more with one a leaf; docs/performance.md, "Instancing").
+  top_options.max_leaf_size = 4;
   BuildInput top_input;
   top_input.positions = corners.data();
   top_input.indices = corner_index.data();
