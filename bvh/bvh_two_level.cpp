@@ -129,7 +129,6 @@ Bvh build_two_level(std::vector<Bvh> meshes, const std::vector<std::uint32_t>& f
       throw Error("BVH build: an instance's transform is singular");
     dev::BvhInstance inst{};
     rows_of(glm::inverse(in.to_world), inst.to_object);
-    rows_of(in.to_world, inst.to_world);
     inst.meta = dev::uint4{0u, 0xffffffffu, det < 0.0 ? WP_INSTANCE_MIRROR : 0u, in.mesh};
     glm::vec3 lo, hi;
     world_box(in.to_world, mesh.lo, mesh.hi, lo, hi);
@@ -142,9 +141,9 @@ Bvh build_two_level(std::vector<Bvh> meshes, const std::vector<std::uint32_t>& f
 
   BuildOptions top_options = options;
   top_options.spatial_splits = false;  // the boxes are the primitives
-  // Up to 4 instances a leaf (one block of the wide layout): with 112 bytes a BvhInstance, 4 a
-  // reference and the top-level nodes, 132 bytes an instance at width 8 and 165 at width 2 (220
-  // and more with one a leaf; docs/performance.md, "Instancing").
+  // Up to 4 instances a leaf (one block of the wide layout): with 64 bytes a BvhInstance, 4 a
+  // reference and the top-level nodes, 84 bytes an instance at width 8 and 117 at width 2 (more
+  // with one a leaf; docs/performance.md, "Instancing").
   top_options.max_leaf_size = 4;
   BuildInput top_input;
   top_input.positions = corners.data();

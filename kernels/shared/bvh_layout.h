@@ -92,8 +92,10 @@ typedef struct TriBlock4 {
 #define WP_INSTANCE_MIRROR 1u /* the transform's determinant is negative (BvhInstance.meta.z) */
 
 typedef struct BvhInstance {
-  float4 to_object[3]; /* rows of the world-to-object affine map: x' = dot(row.xyz, x) + row.w */
-  float4 to_world[3];  /* rows of the object-to-world affine map */
+  /* Rows of the world-to-object affine map: x' = dot(row.xyz, x) + row.w. Shading maps the other
+   * way with its inverse, computed where it is needed (kernels/instance.h): 48 bytes an instance
+   * fewer than storing both. */
+  float4 to_object[3];
   uint4 meta; /* x: the mesh's root node; y: the light of the mesh's first emissive triangle here,
                  or WP_NO_LIGHT (host/lights/light_table.h); z: WP_INSTANCE_* flags; w: mesh */
 } BvhInstance;
