@@ -209,6 +209,16 @@ static inline bool instance_leaf(const SceneView* scene, const TraceRay* r, int 
 #endif
 #endif /* WP_BVH_INSTANCES */
 
+/* The instance of a hit (shared/bvh_layout.h): WP_NO_INSTANCE without a two-level BVH. */
+static inline uint trace_hit_instance(const TraceHit* hit) {
+#if WP_BVH_INSTANCES
+  return hit->inst;
+#else
+  (void)hit;
+  return WP_NO_INSTANCE;
+#endif
+}
+
 /* Closest hit (any = false) or any hit (any = true) in (tmin, tmax). Returns whether something was
  * hit; the hit record holds the closest one found. */
 static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,

@@ -20,6 +20,7 @@
 
 #include "bvh/bvh.h"
 #include "bvh/embree_scene.h"
+#include "host/accel/bvh_input.h"
 #include "host/device/cl_runtime.h"
 #include "host/scene/gltf_loader.h"
 #include "host/render/wavefront.h"
@@ -42,17 +43,10 @@ struct EmbreeScene : wp::bvh::EmbreeScene {
 // The oracle for an instanced scene: Embree's instances of the scene's meshes. Hits are named by
 // their triangle in the scene's flattened twin (flat_twin), as the kernel's are.
 struct EmbreeInstanced {
-  explicit EmbreeInstanced(const wp::Scene& s) : scene(s), embree(make(s)) {}
-  static wp::bvh::EmbreeInstances make(const wp::Scene& s) {
-    std::vector<wp::bvh::EmbreeInstances::MeshRange> meshes;
-    for (const wp::MeshRange& m : s.meshes) meshes.push_back({m.first_triangle, m.triangle_count});
-    std::vector<wp::bvh::InstanceInput> instances;
-    for (const wp::Instance& i : s.instances) instances.push_back({i.to_world, i.mesh});
-    return wp::bvh::EmbreeInstances(s.positions.data(), s.indices.data(), meshes, instances,
-                                    /*robust=*/true);
-  }
+  explicit EmbreeInstanced(const wp::Scene& s)
+      : scene(s), embree(wp::embree_instances(s, /*robust=*/true)) {}
   const wp::Scene& scene;
-  wp::bvh::EmbreeInstances embree;
+  std::unique_ptr<wp::bvh::EmbreeInstances> embree;
 };
 
 // The world of an instanced scene flattened: each instance's triangles mapped into the world, in
@@ -175,7 +169,7 @@ class IntersectKernel : public ::testing::Test {
       check_closest(
           scene, twin.scene, rays, width,
           [&](const wp::bvh::Ray& r) {
-            const wp::bvh::Hit h = embree.embree.intersect(r);
+            const wp::bvh::Hit h = embree.embree->intersect(r);
             return WorldHit{h.hit, h.t, h.hit ? twin.triangle(scene, h.instance, h.triangle) : 0};
           },
           [&](std::uint32_t inst, std::uint32_t tri) { return twin.triangle(scene, inst, tri); });
@@ -285,7 +279,7 @@ class IntersectKernel : public ::testing::Test {
       for (std::size_t i = 0; i < n; ++i) {
         const wp::bvh::Ray ray{
             {so[i].x, so[i].y, so[i].z}, {sd[i].x, sd[i].y, sd[i].z}, 0.0f, so[i].w};
-        const bool theirs = flat ? flat->occluded(ray) : instanced->embree.occluded(ray);
+        const bool theirs = flat ? flat->occluded(ray) : instanced->embree->occluded(ray);
         const bool ours = radiance[i].x == 0.0f;
         occluded += theirs;
         mismatches += ours != theirs;
@@ -317,9 +311,7 @@ class IntersectKernel : public ::testing::Test {
       meshes.push_back(wp::bvh::build(mesh, options));
       first.push_back(m.first_triangle);
     }
-    std::vector<wp::bvh::InstanceInput> instances;
-    for (const wp::Instance& i : s.instances) instances.push_back({i.to_world, i.mesh});
-    return wp::bvh::build_two_level(std::move(meshes), first, instances, options);
+    return wp::bvh::build_two_level(std::move(meshes), first, wp::bvh_instances(s), options);
   }
   static wp::RenderSettings settings() {
     wp::RenderSettings s;

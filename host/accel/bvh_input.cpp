@@ -22,6 +22,20 @@ bvh::BuildInput bvh_input(const Scene& scene, std::vector<std::uint32_t>& flags)
   return input;
 }
 
+std::vector<bvh::InstanceInput> bvh_instances(const Scene& scene) {
+  std::vector<bvh::InstanceInput> out;
+  out.reserve(scene.instances.size());
+  for (const Instance& i : scene.instances) out.push_back({i.to_world, i.mesh});
+  return out;
+}
+
+std::unique_ptr<bvh::EmbreeInstances> embree_instances(const Scene& scene, bool robust) {
+  std::vector<bvh::EmbreeInstances::MeshRange> meshes;
+  for (const MeshRange& m : scene.meshes) meshes.push_back({m.first_triangle, m.triangle_count});
+  return std::make_unique<bvh::EmbreeInstances>(scene.positions.data(), scene.indices.data(),
+                                                meshes, bvh_instances(scene), robust);
+}
+
 bvh::Bvh build_scene_bvh(const Scene& scene, const bvh::BuildOptions& options,
                          const std::string& cache_dir, bool* cached,
                          const std::function<void(const bvh::Bvh&)>& accept) {
@@ -41,10 +55,7 @@ bvh::Bvh build_scene_bvh(const Scene& scene, const bvh::BuildOptions& options,
     all_cached &= hit;
     first.push_back(m.first_triangle);
   }
-  std::vector<bvh::InstanceInput> instances;
-  instances.reserve(scene.instances.size());
-  for (const Instance& i : scene.instances) instances.push_back({i.to_world, i.mesh});
-  bvh::Bvh out = bvh::build_two_level(std::move(meshes), first, instances, options);
+  bvh::Bvh out = bvh::build_two_level(std::move(meshes), first, bvh_instances(scene), options);
   if (cached) *cached = all_cached;
   if (accept) accept(out);
   return out;

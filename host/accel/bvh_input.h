@@ -3,10 +3,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "bvh/embree_scene.h"
 #include "host/scene/scene.h"
 
 namespace wp {
@@ -14,6 +16,13 @@ namespace wp {
 // The BVH build input for `scene`: its triangles, and per triangle the WP_TRI_* flags its
 // material implies (back-face culling for single-sided materials, alpha testing), kept in `flags`.
 bvh::BuildInput bvh_input(const Scene& scene, std::vector<std::uint32_t>& flags);
+
+// An instanced scene's instances as the two-level builder and Embree take them.
+std::vector<bvh::InstanceInput> bvh_instances(const Scene& scene);
+
+// Embree's own instancing of an instanced scene's meshes and instances (the tests' oracle, the
+// bench's reference); `robust` as for bvh::EmbreeScene.
+std::unique_ptr<bvh::EmbreeInstances> embree_instances(const Scene& scene, bool robust);
 
 // The scene's BVH: one tree over its triangles, or, for an instanced scene (Scene::instances),
 // the two-level BVH over its instances (bvh.h, build_two_level), each mesh's tree built over that

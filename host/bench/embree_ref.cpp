@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "host/accel/bvh_input.h"
 #include "host/util/error.h"
 
 namespace wp::bench {
@@ -67,12 +68,7 @@ EmbreeRef::EmbreeRef(const Scene& s) {
     handle_ = flat_->handle();
     return;
   }
-  std::vector<bvh::EmbreeInstances::MeshRange> meshes;
-  for (const MeshRange& m : s.meshes) meshes.push_back({m.first_triangle, m.triangle_count});
-  std::vector<bvh::InstanceInput> instances;
-  for (const Instance& i : s.instances) instances.push_back({i.to_world, i.mesh});
-  instanced_ = std::make_unique<bvh::EmbreeInstances>(s.positions.data(), s.indices.data(), meshes,
-                                                      instances, /*robust=*/false);
+  instanced_ = embree_instances(s, /*robust=*/false);
   handle_ = instanced_->handle();
 }
 

@@ -20,9 +20,7 @@ WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch laun
   TraceHit hit;
   if (bvh_trace(scene, &ray, INFINITY, &hit, false)) {
     path_store_hit(paths, slot, hit.t, hit.u, hit.v, hit.tri);
-#if WP_BVH_INSTANCES
-    path_set_hit_instance(paths, slot, hit.inst);
-#endif
+    path_set_hit_instance(paths, slot, trace_hit_instance(&hit)); /* a no-op without instances */
   } else {
     path_store_hit(paths, slot, INFINITY, 0.0f, 0.0f, 0u);
   }

@@ -46,13 +46,9 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
                         path_radiance(paths, slot) + path_shadow_radiance(paths, slot) * transmit);
       return;
     }
-#if WP_BVH_INSTANCES
-    const uint inst = hit.inst;
-#else
-    const uint inst = WP_NO_INSTANCE;
-#endif
     bool front;
-    const Surface s = resolve_surface(scene, inst, hit.tri, hit.u, hit.v, d, 0.0f, &front);
+    const Surface s =
+        resolve_surface(scene, trace_hit_instance(&hit), hit.tri, hit.u, hit.v, d, 0.0f, &front);
     if (layer == WP_SHADOW_MAX_LAYERS || !bsdf_has_delta(&s) || !bsdf_transmits(&s) ||
         bsdf_volume(&s))
       return; /* an occluder */
