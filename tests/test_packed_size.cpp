@@ -6,7 +6,9 @@
 // buffers are refused before render() builds or caches a BVH, and a scene split over several
 // buffers renders exactly as in one. Counts stand in for scenes of tens of millions of
 // triangles: nothing large is allocated.
+#include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 
@@ -135,6 +137,66 @@ TEST(PackedSize, LayoutAgreesWithPackScene) {
         }
         EXPECT_EQ(packed.desc.triangle_count, 300u);
       }
+    }
+  }
+}
+
+// Packing that frees the host arrays (HostArrays::kRelease, the CLI's) packs the same bytes as
+// packing that keeps them, leaves every padding byte zero (the buffers are not initialised before
+// they are written), and returns the memory of exactly the arrays it names: positions, normals,
+// tangents, UVs, colours, indices, triangle materials, image texels and the BVH's nodes and
+// primitives. In one buffer and split over several, with every vertex array packed, both layouts.
+TEST(PackedSize, ReleasingPackPacksTheSameBytesAndFreesTheHostArrays) {
+  const Scene s = small_scene(300);
+  const auto env = small_map();
+  for (int width : {2, 8}) {
+    const bvh::Bvh b = build_bvh(s, width);
+    const LightTable lights =
+        build_light_table(s, env.get(), glm::vec3(0.0f), 1.0f, LightSelect::kPower);
+    SceneExtras x;
+    x.env = env.get();
+    x.lights = &lights;
+    SceneCounts c = scene_counts(s, env.get());
+    c.lights = lights.lights.size();
+    const std::uint64_t one = scene_layout(c, bvh_bytes(b), kSceneBufferReach).total_bytes();
+    for (std::uint64_t max_buffer : {kSceneBufferReach, one / 3}) {
+      const PackedScene kept = pack_scene(s, b, x, max_buffer);
+      Scene freed_scene = s;
+      bvh::Bvh freed_bvh = b;
+      const PackedScene freed =
+          pack_scene(freed_scene, freed_bvh, x, max_buffer, HostArrays::kRelease);
+      ASSERT_EQ(kept.buffers.size(), freed.buffers.size());
+      for (std::size_t i = 0; i < kept.buffers.size(); ++i)
+        EXPECT_TRUE(kept.buffers[i] == freed.buffers[i]) << "buffer " << i;
+      EXPECT_EQ(std::memcmp(&kept.desc, &freed.desc, sizeof(kept.desc)), 0);
+      EXPECT_EQ(kept.buffer_map, freed.buffer_map);
+      // Every byte outside the arrays is zero.
+      const SceneLayout layout = scene_layout(c, bvh_bytes(b), max_buffer);
+      for (std::size_t buffer = 0; buffer < freed.buffers.size(); ++buffer) {
+        std::vector<char> in_array(freed.buffers[buffer].size(), 0);
+        for (std::size_t a = 0; a < layout.places.size(); ++a)
+          if (std::size_t(layout.places[a].buffer) == buffer)
+            std::fill_n(in_array.begin() + std::ptrdiff_t(layout.places[a].offset), layout.sizes[a],
+                        1);
+        std::size_t nonzero_padding = 0;
+        for (std::size_t k = 0; k < in_array.size(); ++k)
+          nonzero_padding += !in_array[k] && freed.buffers[buffer][k] != 0;
+        EXPECT_EQ(nonzero_padding, 0u) << "buffer " << buffer;
+      }
+      const Scene& f = freed_scene;
+      for (const std::size_t capacity :
+           {f.positions.capacity(), f.normals.capacity(), f.tangents.capacity(), f.uv0.capacity(),
+            f.uv1.capacity(), f.color0.capacity(), f.indices.capacity(),
+            f.triangle_material.capacity(), f.images.at(0).rgba.capacity(),
+            freed_bvh.nodes.capacity(), freed_bvh.nodes8.capacity(), freed_bvh.triangles.capacity(),
+            freed_bvh.blocks.capacity()})
+        EXPECT_EQ(capacity, 0u);
+      // The rest stays.
+      EXPECT_EQ(f.materials.size(), s.materials.size());
+      EXPECT_EQ(f.images.at(0).width, s.images.at(0).width);
+      EXPECT_EQ(f.lights.size(), s.lights.size());
+      EXPECT_EQ(f.cameras.size(), s.cameras.size());
+      EXPECT_EQ(freed_bvh.stats.leaves, b.stats.leaves);
     }
   }
 }
@@ -398,6 +460,12 @@ TEST(PackedSize, SplitSceneRendersExactlyAsOne) {
     ASSERT_GE(scene_layout(c, bvh_bytes(b), total / 5).buffer_bytes.size(), 4u);
     const Rendered split = render(runtime, s, settings);
     EXPECT_EQ(one.image.rgb, split.image.rgb) << "BVH width " << width;
+    // And the render that frees the scene's arrays as it packs them (the CLI's) is the same, its
+    // report counting the triangles it had.
+    const Rendered freed = render(runtime, Scene(s), settings);
+    EXPECT_EQ(one.image.rgb, freed.image.rgb) << "BVH width " << width;
+    EXPECT_EQ(freed.report.triangles, s.triangle_count());
+    EXPECT_EQ(freed.film.info().key, split.film.info().key);
     double sum = 0.0;
     for (float v : one.image.rgb) sum += v;
     EXPECT_GT(sum, 0.0);  // not trivially equal

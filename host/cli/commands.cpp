@@ -128,7 +128,7 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   load.check_counts = [&](const wp::LoadCounts& counts) {
     wp::check_scene_counts(counts, device, mine);
   };
-  const wp::Scene scene = wp::load_gltf(cli.scene, load);
+  wp::Scene scene = wp::load_gltf(cli.scene, load);
   // A camera the scene cannot give (an index past its cameras, a lens on an orthographic one, a
   // focus behind it) is known now, not only once the kernels are built and the BVH is made.
   (void)wp::choose_camera(scene, mine.camera, mine.view, float(mine.width) / float(mine.height));
@@ -168,7 +168,8 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
     options.passes_starting = [&] { signals->arm(); };
     options.interrupted = [&] { return signals->received() != 0; };
   }
-  part.result = wp::render(runtime, scene, mine, options);
+  // The scene is not read after: its arrays are freed as they are packed (one copy of them).
+  part.result = wp::render(runtime, std::move(scene), mine, options);
   progress.finish();
   if (signals) part.stop_signal = signals->received();
   // From here (signals destroyed) a signal removes the outputs' temporary files and ends wavepath.

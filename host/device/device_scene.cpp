@@ -8,6 +8,9 @@
 #include <functional>
 #include <string>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <glm/geometric.hpp>
 
 #include "host/scene/mipmap.h"
@@ -198,22 +201,91 @@ dev::Camera device_camera(const Camera& c, int width, int height) {
 
 namespace {
 
-// One scene array: its size, the SceneDesc field that receives its offset, and what writes it in
-// place: a copy of an array that exists, or, for the per-triangle and per-vertex arrays, their
-// conversion straight into the buffer (no intermediate copy of gigabytes for tens of millions of
-// triangles).
+// One scene array: its elements, the SceneDesc field that receives its offset, and what writes
+// elements [begin, end) in place: a copy of an array that exists, or, for the per-triangle and
+// per-vertex arrays, their conversion straight into the buffer (no intermediate copy of gigabytes
+// for tens of millions of triangles).
 struct SceneArray {
-  std::uint64_t bytes;
+  std::uint64_t count, element_bytes;
   dev::uint* offset;
-  std::function<void(unsigned char*)> write;
+  std::function<void(unsigned char* to, std::size_t begin, std::size_t end)> write;
+  // With HostArrays::kRelease: the host arrays the write reads (element i from the same fraction
+  // i / count of each), and what frees them once it is done.
+  struct Source {
+    unsigned char* data;
+    std::uint64_t bytes;
+  };
+  std::vector<Source> sources = {};
+  std::function<void()> release = {};
+  std::uint64_t bytes() const { return count * element_bytes; }
 };
+
+// The host arrays packing frees as it goes (HostArrays::kRelease); null members: it keeps them.
+struct Owned {
+  Scene* scene = nullptr;
+  bvh::Bvh* bvh = nullptr;
+};
+
+template <class T, class A>
+void free_vector(std::vector<T, A>& v) {
+  std::vector<T, A>().swap(v);
+}
+
+// Marks `vectors` as what `array` reads and frees once written.
+template <class... Vectors>
+void frees(SceneArray& array, Vectors&... vectors) {
+  (array.sources.push_back({reinterpret_cast<unsigned char*>(vectors.data()),
+                            vectors.size() * sizeof(typename Vectors::value_type)}),
+   ...);
+  array.release = [&vectors...] { (free_vector(vectors), ...); };
+}
+
+// An array with sources is written this many bytes at a time, and the pages of its sources read
+// so far are returned to the system after each slice (pack), so that the host never holds more
+// than about a slice of an array twice (tests/test_scale_flat.py bounds the peak with it).
+constexpr std::uint64_t kReleaseSlice = std::uint64_t(16) << 20;
+
+// Writes `a` at `to`; with sources, slice by slice, returning each source's pages once read
+// (madvise MADV_DONTNEED: they are not read again, and are freed whole right after), then frees
+// the sources.
+void write_array(const SceneArray& a, unsigned char* to) {
+  if (a.sources.empty() || a.count == 0) {
+    a.write(to, 0, a.count);
+    if (a.release) a.release();
+    return;
+  }
+  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+  // Per source, the first byte not yet returned, at a page boundary inside the source.
+  std::vector<std::uintptr_t> kept;
+  for (const SceneArray::Source& s : a.sources)
+    kept.push_back((reinterpret_cast<std::uintptr_t>(s.data) + page - 1) & ~(page - 1));
+  const std::size_t step = std::max<std::uint64_t>(1, kReleaseSlice / a.element_bytes);
+  for (std::size_t begin = 0; begin < a.count; begin += step) {
+    const std::size_t end = std::min<std::size_t>(a.count, begin + step);
+    a.write(to, begin, end);
+    for (std::size_t k = 0; k < a.sources.size(); ++k) {
+      const SceneArray::Source& s = a.sources[k];
+      // Elements [0, end) read at most these first bytes (each element's share, rounded down).
+      const std::uintptr_t read =
+          reinterpret_cast<std::uintptr_t>(s.data) + s.bytes / a.count * end;
+      const std::uintptr_t upto = read & ~(page - 1);
+      if (upto > kept[k]) {
+        madvise(reinterpret_cast<void*>(kept[k]), upto - kept[k], MADV_DONTNEED);
+        kept[k] = upto;
+      }
+    }
+  }
+  a.release();
+}
 
 template <class Items>
 SceneArray copy_array(const Items& items, dev::uint& offset) {
-  const std::uint64_t bytes = items.size() * sizeof(items[0]);
-  const void* data = items.data();
-  return SceneArray{bytes, &offset, [data, bytes](unsigned char* to) {
-                      if (bytes) std::memcpy(to, data, bytes);
+  const std::uint64_t size = sizeof(items[0]);
+  const unsigned char* data = reinterpret_cast<const unsigned char*>(items.data());
+  return SceneArray{items.size(), size, &offset,
+                    [data, size](unsigned char* to, std::size_t begin, std::size_t end) {
+                      if (end > begin)
+                        std::memcpy(to + begin * size, data + begin * size, (end - begin) * size);
                     }};
 }
 
@@ -221,9 +293,10 @@ SceneArray copy_array(const Items& items, dev::uint& offset) {
 template <class Make>
 SceneArray convert_array(std::size_t count, dev::uint& offset, Make make) {
   using T = decltype(make(std::size_t{0}));
-  return SceneArray{count * sizeof(T), &offset, [count, make](unsigned char* to) {
+  return SceneArray{count, sizeof(T), &offset,
+                    [make](unsigned char* to, std::size_t begin, std::size_t end) {
                       T* out = reinterpret_cast<T*>(to);
-                      for (std::size_t i = 0; i < count; ++i) out[i] = make(i);
+                      for (std::size_t i = begin; i < end; ++i) out[i] = make(i);
                     }};
 }
 
@@ -245,45 +318,56 @@ DeviceMaterials device_materials(const Scene& scene, bool mipmaps) {
   return m;
 }
 
-// The per-triangle and per-vertex arrays, in kArrayNames' order from tri_vertices on.
+// The per-triangle and per-vertex arrays, in kArrayNames' order from tri_vertices on. An array
+// the program does not read is not packed, but its source is freed all the same.
 void add_geometry_arrays(const Scene& scene, const VertexArrays& packed, dev::SceneDesc& d,
-                         std::vector<SceneArray>& arrays) {
+                         Scene* owned, std::vector<SceneArray>& arrays) {
   const std::size_t tris = scene.triangle_count(), verts = scene.positions.size();
   arrays.push_back(convert_array(tris, d.tri_vertices, [&](std::size_t i) {
     return dev::uint4{scene.indices[3 * i], scene.indices[3 * i + 1], scene.indices[3 * i + 2],
                       scene.triangle_material[i]};
   }));
+  if (owned) frees(arrays.back(), owned->indices, owned->triangle_material);
   arrays.push_back(
       convert_array(verts, d.positions, [&](std::size_t i) { return f4(scene.positions[i]); }));
+  if (owned) frees(arrays.back(), owned->positions);
   arrays.push_back(
       convert_array(verts, d.normals, [&](std::size_t i) { return f4(scene.normals[i]); }));
+  if (owned) frees(arrays.back(), owned->normals);
   arrays.push_back(convert_array(packed.tangents ? verts : 0, d.tangents, [&](std::size_t i) {
     return i < scene.tangents.size() ? f4(scene.tangents[i]) : dev::float4{1, 0, 0, 1};
   }));
+  if (owned) frees(arrays.back(), owned->tangents);
   arrays.push_back(convert_array(packed.uvs ? verts : 0, d.uvs, [&](std::size_t i) {
     const glm::vec2 uv0 = i < scene.uv0.size() ? scene.uv0[i] : glm::vec2(0.0f);
     const glm::vec2 uv1 = i < scene.uv1.size() ? scene.uv1[i] : glm::vec2(0.0f);
     return dev::float4{uv0.x, uv0.y, uv1.x, uv1.y};
   }));
+  if (owned) frees(arrays.back(), owned->uv0, owned->uv1);
   arrays.push_back(convert_array(packed.colors ? verts : 0, d.colors, [&](std::size_t i) {
     return i < scene.color0.size() ? f4(scene.color0[i]) : dev::float4{1, 1, 1, 1};
   }));
+  if (owned) frees(arrays.back(), owned->color0);
 }
 
 // Every array in kArrayNames' order. The BVH is in the layout the program was built for
 // (WP_BVH_WIDTH): the same two fields either way.
 std::vector<SceneArray> scene_arrays(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
-                                     const DeviceMaterials& m, dev::SceneDesc& d) {
+                                     DeviceMaterials& m, dev::SceneDesc& d, Owned owned) {
   std::vector<SceneArray> arrays;
   arrays.push_back(bvh.width == 8 ? copy_array(bvh.nodes8, d.bvh_nodes)
                                   : copy_array(bvh.nodes, d.bvh_nodes));
+  if (owned.bvh) frees(arrays.back(), owned.bvh->nodes8, owned.bvh->nodes);
   arrays.push_back(bvh.width == 8 ? copy_array(bvh.blocks, d.isect_tris)
                                   : copy_array(bvh.triangles, d.isect_tris));
-  add_geometry_arrays(scene, x.vertex_arrays, d, arrays);
+  if (owned.bvh) frees(arrays.back(), owned.bvh->blocks, owned.bvh->triangles);
+  add_geometry_arrays(scene, x.vertex_arrays, d, owned.scene, arrays);
   arrays.push_back(copy_array(m.materials, d.materials));
   arrays.push_back(copy_array(m.textures, d.textures));
   arrays.push_back(copy_array(m.images, d.images));
   arrays.push_back(copy_array(m.texels, d.texels));
+  // The device texels are a copy of the images' (device_materials), made before any buffer.
+  if (owned.scene) frees(arrays.back(), m.texels);
   arrays.push_back(copy_array(x.lights->lights, d.lights));
   arrays.push_back(copy_array(x.lights->alias, d.light_alias));
   arrays.push_back(copy_array(x.lights->tri_light, d.tri_light));
@@ -325,31 +409,54 @@ void describe_scene(const Scene& scene, const SceneExtras& x, dev::SceneDesc& d)
   }
 }
 
-}  // namespace
-
-PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
-                       std::uint64_t max_buffer) {
-  const DeviceMaterials materials = device_materials(scene, x.mipmaps);
+// pack_scene, freeing what `owned` names as it goes.
+PackedScene pack(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
+                 std::uint64_t max_buffer, Owned owned) {
+  DeviceMaterials materials = device_materials(scene, x.mipmaps);
+  if (owned.scene)
+    for (Image& image : owned.scene->images) free_vector(image.rgba);
   PackedScene p;
   p.texel_bytes = materials.texels.size() * kTexelBytes;
   std::uint64_t level0 = 0;
   for (const dev::TextureImage& image : materials.images)
     level0 += std::uint64_t(image.width) * image.height * kTexelBytes;
   p.mip_bytes = p.texel_bytes - level0;
-  const std::vector<SceneArray> arrays = scene_arrays(scene, bvh, x, materials, p.desc);
+  describe_scene(scene, x, p.desc);  // before the arrays it counts may be freed
+  const std::vector<SceneArray> arrays = scene_arrays(scene, bvh, x, materials, p.desc, owned);
   std::vector<std::uint64_t> sizes;
-  for (const SceneArray& a : arrays) sizes.push_back(a.bytes);
+  for (const SceneArray& a : arrays) sizes.push_back(a.bytes());
   const SceneLayout layout = plan_scene_layout(sizes, max_buffer);
+  // The buffers' bytes are not initialised (PageAligned): each is written once, array by array
+  // with the gaps between them zeroed, so that a page is resident only once it is filled.
   p.buffers.resize(layout.buffer_bytes.size());
+  std::vector<std::uint64_t> filled(p.buffers.size(), 0);
   for (std::size_t i = 0; i < p.buffers.size(); ++i) p.buffers[i].resize(layout.buffer_bytes[i]);
   for (std::size_t i = 0; i < arrays.size(); ++i) {
     const SceneLayout::Place place = layout.places[i];
-    arrays[i].write(p.buffers[place.buffer].data() + place.offset);
+    unsigned char* const buffer = p.buffers[place.buffer].data();
+    std::uint64_t& end = filled[static_cast<std::size_t>(place.buffer)];
+    std::memset(buffer + end, 0, place.offset - end);
+    write_array(arrays[i], buffer + place.offset);
+    end = place.offset + arrays[i].bytes();
     *arrays[i].offset = static_cast<dev::uint>(place.offset / WP_SCENE_ALIGN);
   }
+  for (std::size_t b = 0; b < p.buffers.size(); ++b)
+    std::memset(p.buffers[b].data() + filled[b], 0, p.buffers[b].size() - filled[b]);
   p.buffer_map = layout.buffer_map();
-  describe_scene(scene, x, p.desc);
   return p;
+}
+
+}  // namespace
+
+PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& x,
+                       std::uint64_t max_buffer) {
+  return pack(scene, bvh, x, max_buffer, Owned{});
+}
+
+PackedScene pack_scene(Scene& scene, bvh::Bvh& bvh, const SceneExtras& x, std::uint64_t max_buffer,
+                       HostArrays host) {
+  return pack(scene, bvh, x, max_buffer,
+              host == HostArrays::kRelease ? Owned{&scene, &bvh} : Owned{});
 }
 
 std::uint64_t SceneLayout::buffer_map() const {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -21,7 +22,9 @@
 namespace wp {
 
 // Bytes at a page boundary, so that a CPU device can use them in place (CL_MEM_USE_HOST_PTR:
-// PoCL then makes no copy of a scene that may be gigabytes; scene_buffers.h).
+// PoCL then makes no copy of a scene that may be gigabytes; scene_buffers.h). Elements are
+// default-initialised: a buffer of bytes that is resized is not written (pack_scene writes every
+// byte itself), so its pages become resident only as they are filled.
 template <class T>
 struct PageAligned {
   using value_type = T;
@@ -31,6 +34,14 @@ struct PageAligned {
   PageAligned(const PageAligned<U>&) {}
   T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlign)); }
   void deallocate(T* p, std::size_t) { ::operator delete(p, kAlign); }
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
   template <class U>
   bool operator==(const PageAligned<U>&) const {
     return true;
@@ -88,6 +99,21 @@ struct SceneExtras {
 // _SIZE; capped at kSceneBufferReach). Throws plan_scene_layout's wp::Error when it does not fit.
 PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtras& extras,
                        std::uint64_t max_buffer = kSceneBufferReach);
+
+// Whether packing frees the host arrays it has copied.
+enum class HostArrays {
+  kKeep,
+  // Each of the scene's per-vertex and per-triangle arrays (positions, normals, tangents, UVs,
+  // colours, indices, triangle materials) and the BVH's nodes and primitives is emptied (its
+  // memory returned) as soon as it is packed, so that the host never holds a large scene twice:
+  // the peak while packing is the packed scene plus about the largest of those arrays. Their
+  // counts go with them (Scene::triangle_count() is 0 after); the rest of both stays: materials,
+  // images, lights, cameras, meshes and instances, the BVH's stats and instances.
+  kRelease,
+};
+// pack_scene, freeing the host arrays with HostArrays::kRelease.
+PackedScene pack_scene(Scene& scene, bvh::Bvh& bvh, const SceneExtras& extras,
+                       std::uint64_t max_buffer, HostArrays host);
 
 // Where the arrays go. Each array, in pack_scene's order, starts at the next 64-byte boundary of
 // the last buffer, or at the start of a new buffer when it would end past max_buffer there.

@@ -247,17 +247,20 @@ bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings&
                          });
 }
 
-// What the set-up made: device, program, BVH, wave and scene sizes.
-void report_setup(RenderReport& r, const ClRuntime& runtime, const Scene& scene,
-                  const bvh::Bvh& bvh, bool bvh_cached, const Wavefront& wavefront) {
-  r.device = runtime.device().name;
-  r.features = wavefront.features().describe();
-  r.build_options = wavefront.build_options();
+// What the scene is: its triangles and instances, and its BVH's (before packing may free them).
+void report_scene(RenderReport& r, const Scene& scene, const bvh::Bvh& bvh, bool bvh_cached) {
   r.triangles = scene.triangle_count();
   r.instances = scene.instances.size();
   r.world_triangles = scene.world_triangle_count();
   r.bvh = bvh.stats;
   r.bvh_cached = bvh_cached;
+}
+
+// What the set-up made: device, program, wave and scene sizes.
+void report_setup(RenderReport& r, const ClRuntime& runtime, const Wavefront& wavefront) {
+  r.device = runtime.device().name;
+  r.features = wavefront.features().describe();
+  r.build_options = wavefront.build_options();
   r.kernel_cached = wavefront.kernel_cached();
   r.kernel_build_seconds = wavefront.build_seconds();
   r.kernel_binary_bytes = wavefront.binary_bytes();
@@ -394,10 +397,9 @@ class PassScheduler {
   std::chrono::steady_clock::time_point passes_start_, last_checkpoint_;
 };
 
-}  // namespace
-
-Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
-                const RenderOptions& options) {
+// render(); `owned` is null or `scene`, whose host arrays are then freed as they are packed.
+Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
+                      const RenderSettings& settings, const RenderOptions& options) {
   validate(settings);
   const auto start = std::chrono::steady_clock::now();
   bvh::BuildOptions bvh_options = options.bvh;
@@ -405,12 +407,15 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   check_state_memory(state_memory(settings, render_features(scene, settings)), settings,
                      runtime.device());
   bool cached = false;
-  const bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
-  Wavefront wavefront(runtime, scene, bvh, settings);
-
+  bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
   Rendered out;
   RenderReport& r = out.report;
-  report_setup(r, runtime, scene, bvh, cached, wavefront);
+  report_scene(r, scene, bvh, cached);
+  // From here on, with `owned`, the scene's geometry and the BVH's arrays are gone (render_key
+  // reads neither).
+  Wavefront wavefront = owned ? Wavefront(runtime, *owned, bvh, settings, HostArrays::kRelease)
+                              : Wavefront(runtime, scene, bvh, settings);
+  report_setup(r, runtime, wavefront);
   r.setup_seconds = since(start);
   FilmInfo info;
   info.width = settings.width;
@@ -438,6 +443,18 @@ Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& se
   out.image = {settings.width, settings.height, std::move(images.mean)};
   out.variance = {settings.width, settings.height, std::move(images.variance)};
   return out;
+}
+
+}  // namespace
+
+Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
+                const RenderOptions& options) {
+  return render_scene(runtime, scene, nullptr, settings, options);
+}
+
+Rendered render(ClRuntime& runtime, Scene&& scene, const RenderSettings& settings,
+                const RenderOptions& options) {
+  return render_scene(runtime, scene, &scene, settings, options);
 }
 
 }  // namespace wp

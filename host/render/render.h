@@ -116,6 +116,11 @@ struct Rendered {
 // Throws wp::Error on invalid settings or device failures.
 Rendered render(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
                 const RenderOptions& options = {});
+// The same render of a scene that is not needed after it: its geometry and images are freed as
+// they are packed (HostArrays::kRelease), so that a large scene is not held twice; `scene` is left
+// without them.
+Rendered render(ClRuntime& runtime, Scene&& scene, const RenderSettings& settings,
+                const RenderOptions& options = {});
 
 // The render key: one line naming everything that changes the image, so that films merge only
 // with films of the same render (host/film/film.h). ';'-separated name=value fields: the scene's
@@ -139,8 +144,12 @@ void check_scene_memory(std::uint64_t bytes, const DeviceEntry& device, std::uin
 // sizes) when a scene of these counts cannot be held, before the loader allocates for it: the
 // least packed scene its triangles need (their vertex references and light slots, the least BVH
 // of `device`'s layout; check_scene_memory, and a single array larger than a device buffer) plus,
-// in host memory, the loader's 16 bytes a triangle (indices, material). A mesh placed by many
-// nodes counts once per node (no instancing yet), so such a scene is refused from its node count
+// in host memory, the loader's 16 bytes a triangle (indices, material). The CLI frees the loaded
+// arrays while it packs them (HostArrays::kRelease), so the two are not held at once; the sum is
+// still a lower bound of its peak for any mesh with at least 3 vertices per 8 triangles (closed
+// meshes have about 1 per 2): after packing it holds the packed vertices (32 bytes each, left out
+// of the least packed scene) and the light table (4 bytes a triangle). A mesh placed by many
+// nodes counts once per placement when flattened, so such a scene is refused from its node count
 // alone instead of growing until the system kills the process.
 void check_scene_counts(const LoadCounts& counts, const DeviceEntry& device,
                         const RenderSettings& settings);

@@ -98,6 +98,15 @@ SceneFeatures render_features(const Scene& scene, const RenderSettings& settings
 
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
+    : Wavefront(runtime, scene, bvh, settings, nullptr, nullptr) {}
+
+Wavefront::Wavefront(ClRuntime& runtime, Scene& scene, bvh::Bvh& bvh,
+                     const RenderSettings& settings, HostArrays host)
+    : Wavefront(runtime, scene, bvh, settings, host == HostArrays::kRelease ? &scene : nullptr,
+                host == HostArrays::kRelease ? &bvh : nullptr) {}
+
+Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+                     const RenderSettings& settings, Scene* owned_scene, bvh::Bvh* owned_bvh)
     : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
   const WaveShape wave = wave_shape(settings);
   wave_size_ = wave.pixels;
@@ -125,7 +134,7 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
   try {
-    upload(scene, bvh);
+    upload(scene, bvh, owned_scene, owned_bvh);
     allocate_state();
   } catch (const cl::Error& e) {
     rethrow_cl(e, "allocating device memory on " + rt_.device().name);
@@ -133,7 +142,8 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   build_program();
 }
 
-void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
+void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh, Scene* owned_scene,
+                       bvh::Bvh* owned_bvh) {
   SceneExtras extras;
   extras.camera = pick_camera(scene, settings_);
   extras.background = settings_.background;
@@ -146,7 +156,10 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh) {
   // On a CPU device the kernels read the packed scene in place, which therefore stays here; a GPU
   // gets its own copy, and the host's goes at the end of this function.
   const bool in_place = !rt_.device().gpu;
-  PackedScene packed = pack_scene(scene, bvh, extras, scene_buffer_limit(rt_.device(), settings_));
+  const std::uint64_t max_buffer = scene_buffer_limit(rt_.device(), settings_);
+  PackedScene packed = owned_scene && owned_bvh ? pack_scene(*owned_scene, *owned_bvh, extras,
+                                                             max_buffer, HostArrays::kRelease)
+                                                : pack_scene(scene, bvh, extras, max_buffer);
   scene_ = upload_scene(rt_.context(), packed, in_place);
   scene_buffer_count_ = static_cast<int>(packed.buffers.size());
   for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();

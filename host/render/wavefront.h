@@ -140,6 +140,10 @@ class Wavefront {
   // been built over `scene`'s triangles.
   Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
             const RenderSettings& settings);
+  // The same, freeing the host arrays of `scene` and `bvh` as they are packed with
+  // HostArrays::kRelease (pack_scene): for a caller that reads neither's geometry afterwards.
+  Wavefront(ClRuntime& runtime, Scene& scene, bvh::Bvh& bvh, const RenderSettings& settings,
+            HostArrays host);
 
   // Renders sample indices [sample, sample + samples) for every pixel and adds them to the film;
   // 1 <= samples <= samples_per_wave().
@@ -227,7 +231,10 @@ class Wavefront {
   using QueueCounts = std::array<dev::uint, WP_QUEUE_COUNT>;
   // The constructor's steps: the packed scene to the device, the path state, queues, counters and
   // film allocated, the program built and this pipeline's kernels made and primed.
-  void upload(const Scene& scene, const bvh::Bvh& bvh);
+  // owned_scene and owned_bvh: null, or `scene` and `bvh`, whose host arrays packing then frees.
+  Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+            const RenderSettings& settings, Scene* owned_scene, bvh::Bvh* owned_bvh);
+  void upload(const Scene& scene, const bvh::Bvh& bvh, Scene* owned_scene, bvh::Bvh* owned_bvh);
   void allocate_state();
   void build_program();
   void prime_kernels();
