@@ -355,4 +355,27 @@ TEST_F(Cli, MaterialVariantsAreDifferentRenders) {
   }
 }
 
+// The films of an instanced scene merge as any others: two sample ranges of SimpleInstancing (125
+// instances of a cube, rendered through the two-level BVH) merge into the film and image of the
+// whole range, bit for bit; a film of the same file flattened (--instancing off: the same image to
+// float rounding, not bit for bit) is another render and does not merge with them.
+TEST_F(Cli, InstancedFilmsMergeBitForBit) {
+  WP_REQUIRE_MODEL(model, "SimpleInstancing/SimpleInstancing.glb");
+  const std::string render = "render '" + model + "' --env-color 1,1,1 --width 16 --height 12 -q ";
+  for (const char* args :
+       {"--samples 0:5 -o all.wpfilm -o all.pfm", "--samples 0:2 -o a.wpfilm",
+        "--samples 2:5 -o b.wpfilm", "--samples 2:5 --instancing off -o flat.wpfilm"}) {
+    const CliRun r = run(render + args);
+    ASSERT_EQ(r.status, 0) << args << ": " << r.err;
+  }
+  const CliRun merged = run("merge a.wpfilm b.wpfilm -o merged.wpfilm -o merged.pfm -q");
+  ASSERT_EQ(merged.status, 0) << merged.err;
+  EXPECT_EQ(slurp(dir_ / "merged.pfm"), slurp(dir_ / "all.pfm"));
+  EXPECT_EQ(slurp(dir_ / "merged.wpfilm"), slurp(dir_ / "all.wpfilm"));
+  const CliRun mixed = run("merge a.wpfilm flat.wpfilm -o mixed.pfm");
+  EXPECT_NE(mixed.status, 0);
+  EXPECT_NE(mixed.err.find("does not merge"), std::string::npos) << mixed.err;
+  EXPECT_FALSE(fs::exists(dir_ / "mixed.pfm"));
+}
+
 }  // namespace
