@@ -92,8 +92,11 @@ std::vector<std::string> default_scenes() {
                               : fs::path(WP_SOURCE_DIR).parent_path() / "shared" / "assets";
   const fs::path models = assets / "models";
   if (!fs::is_directory(models)) return out;
+  // SimpleInstancing: one mesh placed by 125 instances, traversed through the two-level BVH
+  // (against Embree's own instancing).
   for (const char* m : {"DamagedHelmet/DamagedHelmet.glb", "FlightHelmet/FlightHelmet.gltf",
-                        "MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb"})
+                        "MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.glb",
+                        "SimpleInstancing/SimpleInstancing.glb"})
     if (fs::exists(models / m)) out.push_back((models / m).lexically_normal().string());
   return out;
 }
