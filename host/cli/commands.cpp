@@ -116,6 +116,13 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   wp::RenderSettings mine = settings;
   mine.sample_begin = slice.first;
   mine.spp = slice.samples;
+  wp::RenderOptions options;
+  if (cli.time_limit > 0)
+    options.deadline = program_start + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                           std::chrono::duration<double>(cli.time_limit));
+  // Rank 0's passes stand for the job's: the ranks render at about the same pace.
+  Progress progress(!cli.quiet && ranks.root(), isatty(STDERR_FILENO), cli.progress_every,
+                    double(settings.width) * settings.height, options.deadline);
   // Read whole before loading the scene (a bad file fails at once) and before rendering (it may
   // be the --checkpoint file, which the render replaces).
   std::optional<wp::Film> resume;
@@ -128,27 +135,25 @@ RenderPart render_part(const CliOptions& cli, const wp::RenderSettings& settings
   load.check_counts = [&](const wp::LoadCounts& counts) {
     wp::check_scene_counts(counts, device, mine);
   };
+  progress.step("loading " + cli.scene);
   wp::Scene scene = wp::load_gltf(cli.scene, load);
   // A camera the scene cannot give (an index past its cameras, a lens on an orthographic one, a
   // focus behind it) is known now, not only once the kernels are built and the BVH is made.
   (void)wp::choose_camera(scene, mine.camera, mine.view, float(mine.width) / float(mine.height));
   part.load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!cli.quiet && ranks.root())
+  if (!cli.quiet && ranks.root() && !scene.warnings.empty()) {
+    progress.clear();
     for (const auto& w : scene.warnings) std::fprintf(stderr, "wavepath: warning: %s\n", w.c_str());
+  }
 
+  progress.step("starting " + device.name);
   wp::ClRuntime runtime(device);
-  wp::RenderOptions options;
   options.bvh.spatial_splits = cli.spatial_splits;
   options.bvh_cache = !cli.no_bvh_cache;
-  if (cli.time_limit > 0)
-    options.deadline = program_start + std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                           std::chrono::duration<double>(cli.time_limit));
   options.noise_threshold = cli.noise_threshold;
   if (resume) options.resume = &*resume;
-  // Rank 0's passes stand for the job's: the ranks render at about the same pace.
-  Progress progress(!cli.quiet && ranks.root(), isatty(STDERR_FILENO), cli.progress_every,
-                    double(settings.width) * settings.height, options.deadline);
+  options.setup_step = [&](const std::string& what) { progress.step(what); };
   options.progress = [&](int done, int total, double seconds, int rendered) {
     progress.update(done, total, seconds, rendered);
   };

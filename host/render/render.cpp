@@ -406,8 +406,16 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
   bvh_options.width = bvh_width(runtime.device(), settings);
   check_state_memory(state_memory(settings, render_features(scene, settings)), settings,
                      runtime.device());
+  const auto step = [&](const std::string& what) {
+    if (options.setup_step) options.setup_step(what);
+  };
+  step((options.bvh_cache ? "finding or building the BVH of " : "building the BVH of ") +
+       std::to_string(scene.triangle_count()) + " triangles" +
+       (scene.instances.empty() ? std::string()
+                                : " in " + std::to_string(scene.instances.size()) + " instances"));
   bool cached = false;
   bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
+  step("packing the scene and building the kernels");
   Rendered out;
   RenderReport& r = out.report;
   report_scene(r, scene, bvh, cached);

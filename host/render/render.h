@@ -81,6 +81,9 @@ struct RenderOptions {
   // Called after each sample pass with (samples in the film, samples requested, seconds since
   // the start of the passes, samples rendered by this call: the film's less any resumed).
   std::function<void(int, int, double, int)> progress;
+  // Called as each step of the set-up before the passes starts, with what it does, e.g.
+  // "building the BVH of 20000000 triangles" (the CLI's status line on a terminal).
+  std::function<void(const std::string&)> setup_step;
 
   // Continue this film (a checkpoint) instead of starting from zero: the same render key and
   // size, and samples [sample_begin, k) with k <= sample_begin + spp of the settings. Its samples
