@@ -104,11 +104,12 @@ PackedScene pack_scene(const Scene& scene, const bvh::Bvh& bvh, const SceneExtra
 enum class HostArrays {
   kKeep,
   // Each of the scene's per-vertex and per-triangle arrays (positions, normals, tangents, UVs,
-  // colours, indices, triangle materials) and the BVH's nodes and primitives is emptied (its
-  // memory returned) as soon as it is packed, so that the host never holds a large scene twice:
-  // the peak while packing is the packed scene plus about the largest of those arrays. Their
-  // counts go with them (Scene::triangle_count() is 0 after); the rest of both stays: materials,
-  // images, lights, cameras, meshes and instances, the BVH's stats and instances.
+  // colours, indices, triangle materials), its images' texels and the BVH's nodes and primitives
+  // is emptied (its memory returned) as it is packed, 16 MiB at a time (the pages read so far
+  // returned after each slice), so that the host never holds a large scene twice: packing adds
+  // about one slice to the packed scene. Their counts go with them (Scene::triangle_count() is 0
+  // after); the rest of both stays: materials, image sizes, lights, cameras, meshes and
+  // instances, the BVH's stats and instances.
   kRelease,
 };
 // pack_scene, freeing the host arrays with HostArrays::kRelease.
