@@ -1,5 +1,7 @@
 #include "host/cli/info.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -8,6 +10,7 @@
 #include "host/accel/bvh_cache.h"
 #include "host/accel/bvh_input.h"
 #include "host/cli/options.h"
+#include "host/cli/progress.h"
 #include "host/lights/light_table.h"
 #include "host/render/render.h"
 #include "host/scene/gltf_loader.h"
@@ -80,7 +83,8 @@ BvhInfo bvh_info(const Scene& scene, const bvh::BuildInput& input, int width, bo
 
 }  // namespace
 
-SceneInfo scene_info(const Scene& scene, const InfoOptions& options) {
+SceneInfo scene_info(const Scene& scene, const InfoOptions& options,
+                     const std::function<void(const std::string&)>& step) {
   SceneInfo info;
   info.extensions = extension_uses(scene.gltf.extensions_used, scene.gltf.extensions_required);
   for (const Material& m : scene.materials)
@@ -106,9 +110,13 @@ SceneInfo scene_info(const Scene& scene, const InfoOptions& options) {
   std::vector<std::uint32_t> flags;
   const bvh::BuildInput input = bvh_input(scene, flags);
   for (const int width : {8, 2})
-    if (options.bvh_width == 0 || options.bvh_width == width)
+    if (options.bvh_width == 0 || options.bvh_width == width) {
+      if (step)
+        step("the " + std::to_string(width) + "-wide BVH of " +
+             std::to_string(scene.triangle_count()) + " triangles");
       info.bvhs.push_back(
           bvh_info(scene, input, width, options.spatial_splits, !options.no_bvh_build, counts));
+    }
   return info;
 }
 
@@ -117,19 +125,25 @@ int info_command(const InfoOptions& options) {
   size.width = options.width;
   size.height = options.height;
   validate(size);  // --width and --height as render checks them
+  // On a terminal, the step under way (loading, each BVH) on stderr, cleared before the report.
+  Progress progress(true, isatty(STDERR_FILENO), 0.0, 0.0, std::nullopt);
   std::optional<Scene> scene;
   try {
     LoadOptions load(options.variant);
     load.instancing = instancing_mode(options.instancing);
     load.check_counts = check_host_counts;  // a scene the host cannot load is refused first
+    progress.step("loading " + options.scene);
     scene = load_gltf(options.scene, load);
   } catch (const RefusedExtensions& e) {
+    progress.clear();
     std::cout << (options.json ? refused_json(options.scene, e.what(), e.uses())
                                : refused_text(options.scene, e.uses()))
               << std::flush;
     throw;
   }
-  const SceneInfo info = scene_info(*scene, options);
+  const SceneInfo info =
+      scene_info(*scene, options, [&](const std::string& what) { progress.step(what); });
+  progress.clear();
   std::cout << (options.json ? info_json(*scene, info) : info_text(*scene, info)) << std::flush;
   return 0;
 }

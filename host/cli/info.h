@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -71,7 +72,10 @@ struct SceneInfo {
 
 // The report of `scene` for `options`; builds the BVHs (unless --no-bvh-build) and the light
 // table, reads the BVH cache and writes nothing.
-SceneInfo scene_info(const Scene& scene, const InfoOptions& options);
+// `step`, if set, is told of each BVH layout before it is looked up or built (seconds each for
+// millions of triangles).
+SceneInfo scene_info(const Scene& scene, const InfoOptions& options,
+                     const std::function<void(const std::string&)>& step = {});
 
 // The report for a person, and as one JSON object (one line).
 std::string info_text(const Scene& scene, const SceneInfo& info);
