@@ -615,25 +615,45 @@ static inline void eval_layers(const Surface* s, float3 wo, float3 wi, float cos
 #define WP_BSDF_EVAL_INLINE static inline
 #endif
 
+/* What the BSDF at a surface needs of wo alone, worked out once per scattering event
+ * (bsdf_view): the NEE evaluation, the lobe choice and the evaluation of the sampled direction
+ * share it (each worked it out before, three times the same numbers per bounce). bsdf_eval and
+ * bsdf_sample make their own. */
+typedef struct BsdfView {
+  float cos_o; /* ns . wo */
+#if WP_FEATURE_GLOSSY
+  float eta;   /* relative_ior */
+  Lobes lobes; /* bsdf_lobes at wo; all 0 where cos_o <= 0, which neither evaluates nor samples */
+#endif
+} BsdfView;
+
 #if !WP_FEATURE_GLOSSY
 
+static inline BsdfView bsdf_view(const Surface* s, float3 wo) {
+  BsdfView v = {dot(s->ns, wo)};
+  return v;
+}
+
 /* Lambert: f = base / pi and the cosine-weighted pdf, for wi above both normals. */
-WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
+WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval_view(const Surface* s, const BsdfView* v, float3 wo,
+                                            float3 wi) {
+  (void)wo;
   BsdfEval e = {(float3)(0.0f), 0.0f};
   const float cos_i = dot(s->ns, wi);
-  if (!(dot(s->ns, wo) > 0.0f) || !(cos_i > 0.0f && dot(s->ng, wi) > 0.0f)) return e;
+  if (!(v->cos_o > 0.0f) || !(cos_i > 0.0f && dot(s->ng, wi) > 0.0f)) return e;
   e.f = WP_INV_PI * s->color;
   e.pdf = cosine_hemisphere_pdf(cos_i);
   return e;
 }
 
 /* A cosine-weighted direction; its weight f cos / pdf is the base colour. */
-static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
-  (void)u_lobe;
+static inline BsdfSample bsdf_sample_view(const Surface* s, const BsdfView* v, float3 wo,
+                                          float u_lobe, float2 u) {
+  (void)wo, (void)u_lobe;
   BsdfSample r;
   r.valid = false, r.delta = false, r.pdf = 0.0f, r.eta_scale = 1.0f;
   r.weight = (float3)(0.0f), r.wi = (float3)(0.0f);
-  if (!(dot(s->ns, wo) > 0.0f)) return r;
+  if (!(v->cos_o > 0.0f)) return r;
   float3 t, b;
   make_basis(s->ns, &t, &b);
   const float3 wi_l = sample_cosine_hemisphere(u);
@@ -658,12 +678,23 @@ static inline float3 bsdf_pane_transmittance(const Surface* s, float3 d) {
 
 #else
 
-WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
+static inline BsdfView bsdf_view(const Surface* s, float3 wo) {
+  BsdfView v;
+  v.cos_o = dot(s->ns, wo);
+  v.eta = relative_ior(s);
+  const Lobes none = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  /* Only above the surface: the sheen table is looked up at cos_o. */
+  v.lobes = v.cos_o > 0.0f ? bsdf_lobes(s, wo, v.cos_o, v.eta) : none;
+  return v;
+}
+
+WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval_view(const Surface* s, const BsdfView* v, float3 wo,
+                                            float3 wi) {
   BsdfEval e = {(float3)(0.0f), 0.0f};
-  const float cos_i = dot(s->ns, wi), cos_o = dot(s->ns, wo);
+  const float cos_i = dot(s->ns, wi), cos_o = v->cos_o;
   if (!(cos_o > 0.0f)) return e;
-  const float eta = relative_ior(s);
-  const Lobes l = bsdf_lobes(s, wo, cos_o, eta);
+  const float eta = v->eta;
+  const Lobes l = v->lobes;
   const bool above = cos_i > 0.0f && dot(s->ng, wi) > 0.0f;
   const bool below = cos_i < 0.0f && dot(s->ng, wi) < 0.0f;
   if (above)
@@ -804,7 +835,8 @@ static inline int sample_extra_lobe(const Surface* s, float3 wo, float3 t, float
 }
 #endif
 
-static inline BsdfSample bsdf_sample_lobes(const Surface* s, float3 wo, float u_lobe, float2 u) {
+static inline BsdfSample bsdf_sample_lobes(const Surface* s, const BsdfView* v, float3 wo,
+                                           float u_lobe, float2 u) {
   BsdfSample r;
   r.valid = false, r.delta = false, r.pdf = 0.0f, r.eta_scale = 1.0f;
   r.weight = (float3)(0.0f), r.wi = (float3)(0.0f);
@@ -816,10 +848,10 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, float3 wo, float u_
   } else
 #endif
     make_basis(s->ns, &t, &b);
-  const float3 wo_l = (float3)(dot(wo, t), dot(wo, b), dot(wo, s->ns));
+  const float3 wo_l = (float3)(dot(wo, t), dot(wo, b), v->cos_o);
   if (!(wo_l.z > 0.0f)) return r;
-  const float eta = relative_ior(s);
-  const Lobes l = bsdf_lobes(s, wo, wo_l.z, eta);
+  const float eta = v->eta;
+  const Lobes l = v->lobes;
   const float g = l.spec + l.trans; /* the microfacet lobes */
   if (u_lobe < g && bsdf_has_delta(s)) return sample_delta(s, wo, wo_l.z, eta, l, u_lobe >= l.spec);
   float3 wi_l;
@@ -861,7 +893,7 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, float3 wo, float u_
    * other side's lobes and break the pdf. It is lost, as it should be. */
   if (trans ? wi_l.z >= 0.0f : wi_l.z <= 0.0f) return r;
   r.wi = normalize(wi_l.x * t + wi_l.y * b + wi_l.z * s->ns);
-  const BsdfEval e = bsdf_eval(s, wo, r.wi);
+  const BsdfEval e = bsdf_eval_view(s, v, wo, r.wi);
   if (!(e.pdf > 0.0f)) return r;
   r.pdf = e.pdf;
   r.weight = e.f * fabs(dot(s->ns, r.wi)) / e.pdf;
@@ -875,13 +907,15 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, float3 wo, float u_
  * its weight 3 f_c cos / pdf_c on channel c alone (so each channel's expected weight is its
  * own), and the path keeps the channel. Its pdf is reported as 0: no light sample was taken
  * there (bsdf_only_delta), so what the direction finds counts in full. */
-static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
+static inline BsdfSample bsdf_sample_view(const Surface* s, const BsdfView* v, float3 wo,
+                                          float u_lobe, float2 u) {
 #if WP_FEATURE_DISPERSION
-  if (bsdf_choose_channel(s)) {
+  if (bsdf_choose_channel(s)) { /* the channel's ior: a view of its own */
     Surface sc = *s;
     const uint c = min((uint)(u_lobe * 3.0f), 2u);
     sc.channel = c + 1u;
-    BsdfSample r = bsdf_sample_lobes(&sc, wo, u_lobe * 3.0f - (float)c, u);
+    const BsdfView vc = bsdf_view(&sc, wo);
+    BsdfSample r = bsdf_sample_lobes(&sc, &vc, wo, u_lobe * 3.0f - (float)c, u);
     const float3 mask =
         (float3)(c == 0u ? 3.0f : 0.0f, c == 1u ? 3.0f : 0.0f, c == 2u ? 3.0f : 0.0f);
     r.weight *= mask;
@@ -889,14 +923,26 @@ static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, 
     r.channel = sc.channel;
     return r;
   }
-  BsdfSample r = bsdf_sample_lobes(s, wo, u_lobe, u);
+  BsdfSample r = bsdf_sample_lobes(s, v, wo, u_lobe, u);
   r.channel = s->channel;
   return r;
 #else
-  return bsdf_sample_lobes(s, wo, u_lobe, u);
+  return bsdf_sample_lobes(s, v, wo, u_lobe, u);
 #endif
 }
 
 #endif /* WP_FEATURE_GLOSSY */
+
+/* f and pdf for the pair (wo, wi); bsdf_eval_view with a view made for it. */
+WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {
+  const BsdfView v = bsdf_view(s, wo);
+  return bsdf_eval_view(s, &v, wo, wi);
+}
+
+/* A direction from the lobes at wo; bsdf_sample_view with a view made for it. */
+static inline BsdfSample bsdf_sample(const Surface* s, float3 wo, float u_lobe, float2 u) {
+  const BsdfView v = bsdf_view(s, wo);
+  return bsdf_sample_view(s, &v, wo, u_lobe, u);
+}
 
 #endif /* WP_BSDF_H */

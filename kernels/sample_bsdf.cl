@@ -11,5 +11,6 @@ __kernel void sample_bsdf(WP_STAGE_PARAMS) {
   const Surface s = surface_load(paths, slot);
   BounceRandom u;
   bounce_random(path_rng(paths, slot, launch), &u);
-  sample_next_ray(paths, queues, slot, &s, path_hit_t(paths, slot), &u);
+  const BsdfView v = bsdf_view(&s, -path_ray_dir(paths, slot));
+  sample_next_ray(paths, queues, slot, &s, &v, path_hit_t(paths, slot), &u);
 }

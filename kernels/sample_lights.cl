@@ -14,7 +14,8 @@ WP_GROUP_KERNEL void sample_lights(WP_STAGE_PARAMS) {
     const Surface s = surface_load(paths, slot);
     BounceRandom u;
     bounce_random(path_rng(paths, slot, launch), &u);
-    shadow = sample_light_ray(&scene, paths, queues, slot, &s, path_hit_t(paths, slot), &u);
+    const BsdfView v = bsdf_view(&s, -path_ray_dir(paths, slot));
+    shadow = sample_light_ray(&scene, paths, queues, slot, &s, &v, path_hit_t(paths, slot), &u);
   }
   queue_push_group(queues, WP_QUEUE_SHADOW, shadow, slot, scan);
 #endif

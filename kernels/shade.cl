@@ -30,10 +30,12 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
     if (t < INFINITY) bounce_random(path_rng(paths, slot, launch), &u);
     Surface s;
     if (shade_hit(&scene, paths, launch, slot, &s)) {
+      /* What the BSDF needs of the incoming direction, once for both samples. */
+      const BsdfView v = bsdf_view(&s, -path_ray_dir(paths, slot));
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-      shadow = sample_light_ray(&scene, paths, queues, slot, &s, t, &u);
+      shadow = sample_light_ray(&scene, paths, queues, slot, &s, &v, t, &u);
 #endif
-      sample_next_ray(paths, queues, slot, &s, t, &u);
+      sample_next_ray(paths, queues, slot, &s, &v, t, &u);
       survives = roulette(paths, queues, launch, slot, u.roulette);
     }
   }

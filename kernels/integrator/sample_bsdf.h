@@ -11,12 +11,12 @@
 #include "ray_cone.h"
 #include "surface.h"
 
-/* The next ray of the path in `slot` from surface s, hit at distance t, with the bounce's random
- * numbers u (its lobe choice and direction). */
-WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Surface* s, float t,
-                                 const BounceRandom* u) {
+/* The next ray of the path in `slot` from surface s, seen as v (bsdf_view at -ray_d), hit at
+ * distance t, with the bounce's random numbers u (its lobe choice and direction). */
+WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Surface* s,
+                                 const BsdfView* v, float t, const BounceRandom* u) {
   const float3 ray_d = path_ray_dir(paths, slot);
-  const BsdfSample bs = bsdf_sample(s, -ray_d, u->lobe, u->bsdf_uv);
+  const BsdfSample bs = bsdf_sample_view(s, v, -ray_d, u->lobe, u->bsdf_uv);
   const float3 next = path_throughput(paths, slot) * bs.weight;
   const bool finite = all(isfinite(next)) && isfinite(bs.pdf);
   if (bs.valid && !finite) count_nonfinite(queues);

@@ -11,17 +11,18 @@
 #include "surface.h"
 
 #if WP_STRATEGY != WP_STRATEGY_BSDF
-/* NEE at surface s, hit at distance t, of the path in `slot` with the bounce's random numbers u
- * (its light pick and light point): a shadow ray for WP_QUEUE_SHADOW, true when there is one (the
- * caller pushes it). The fused pipeline's shadow ray takes the hit record's place, so t comes from
- * the caller, which read it before. */
+/* NEE at surface s, seen as v (bsdf_view at -ray_d), hit at distance t, of the path in `slot`
+ * with the bounce's random numbers u (its light pick and light point): a shadow ray for
+ * WP_QUEUE_SHADOW, true when there is one (the caller pushes it). The fused pipeline's shadow ray
+ * takes the hit record's place, so t comes from the caller, which read it before. */
 WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues queues, uint slot,
-                                  const Surface* s, float t, const BounceRandom* u) {
+                                  const Surface* s, const BsdfView* v, float t,
+                                  const BounceRandom* u) {
   if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return false;
   const LightSample ls = sample_light(scene, s->p, u->light_pick, u->light_uv);
   if (!(ls.pdf > 0.0f)) return false;
   const float3 ray_d = path_ray_dir(paths, slot);
-  const BsdfEval e = bsdf_eval(s, -ray_d, ls.wi);
+  const BsdfEval e = bsdf_eval_view(s, v, -ray_d, ls.wi);
   const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
   const float3 c =
       path_throughput(paths, slot) * e.f * ls.li * (fabs(dot(s->ns, ls.wi)) * w / ls.pdf);
