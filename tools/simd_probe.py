@@ -19,8 +19,17 @@ then stores twelve floats of them, so the variants differ only in:
 The rays are wrong beyond the first store (a probe, not a renderer): the later stages' times are
 meaningless, the camera stage's (--profile) is what is compared. The real kernel is timed too.
 
+--layout-cost measures what the "arrays" layout costs the kernels as they are (no SIMD across
+paths): tools/simd_probe_layout.patch changes only the path-state accessors (path_state.h) and
+the cache hints (stage.h) to one array per component within each field's buffer, and whole
+renders with it are timed against the kernels of the tree, alternated run by run; both must give
+the same image bit for bit (checked).
+
   tools/simd_probe.py                      the table of docs/performance.md (5 alternated rounds)
   tools/simd_probe.py --rounds 9 --spp 128
+  tools/simd_probe.py --layout-cost        the layout's cost to the whole pipeline (5 runs each
+                                           of the Cornell box, its Lambertian copy and
+                                           DamagedHelmet when ../shared/assets has it)
   tools/simd_probe.py --check              the ctest: writes the variants and compiles one, which
                                            must get a verdict (fails when the kernel no longer
                                            has the text the probe replaces, or the probe no
@@ -40,9 +49,14 @@ import subprocess
 import sys
 import tempfile
 
+import hashlib
+
 import vectorization
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+LAYOUT_PATCH = os.path.join(ROOT, "tools", "simd_probe_layout.patch")
+HELMET = os.path.join(ROOT, "..", "shared", "assets", "models", "DamagedHelmet",
+                      "DamagedHelmet.glb")
 KERNELS = os.path.join(ROOT, "kernels")
 CAMERA = os.path.join("integrator", "generate_camera_rays.h")
 BEGIN = "WP_STAGE_FN void start_path("
@@ -109,6 +123,52 @@ def make_variant(folder, rng, layout):
         f.write(text)
 
 
+def make_arrays_layout(folder):
+    """kernels/ with the path state in one array per component (tools/simd_probe_layout.patch)."""
+    shutil.copytree(KERNELS, folder)
+    env = dict(os.environ, GIT_CEILING_DIRECTORIES=os.path.dirname(folder))
+    p = subprocess.run(["git", "apply", "-p2", LAYOUT_PATCH], cwd=folder, env=env,
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        fail(f"{os.path.relpath(LAYOUT_PATCH, ROOT)} no longer applies: {p.stderr.strip()}")
+
+
+def layout_cost(a, tmp):
+    """Samples/s of whole renders, the kernels of the tree against the arrays layout."""
+    dirs = {"now": KERNELS, "arrays": os.path.join(tmp, "arrays")}
+    make_arrays_layout(dirs["arrays"])
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import peers_scene
+    scenes = [a.scene, os.path.join(tmp, "lambertian.gltf")]
+    peers_scene.lambertian_copy(a.scene, scenes[1])
+    if os.path.exists(HELMET):
+        scenes.append(HELMET)
+    size = ["--width", str(a.size), "--height", str(a.size), "--spp", str(a.spp)]
+    print(f"Whole renders, {a.size} x {a.size} x {a.spp} spp, samples/s, medians of {a.rounds} "
+          "alternated runs:\n")
+    print("| scene | layout now | one array per component | ratio |")
+    print("|---|--:|--:|--:|")
+    for scene in scenes:
+        rate = {k: [] for k in dirs}
+        digest = {}
+        for k, d in dirs.items():  # one unmeasured run each: the kernel caches
+            out = os.path.join(tmp, k + ".pfm")
+            run(a.wavepath, scene, size + ["-o", out], {"WAVEPATH_KERNEL_DIR": d})
+            with open(out, "rb") as f:
+                digest[k] = hashlib.md5(f.read()).hexdigest()
+        if digest["now"] != digest["arrays"]:
+            fail(f"{scene}: the arrays layout changed the image")
+        for _ in range(a.rounds):
+            for k, d in dirs.items():
+                out = run(a.wavepath, scene, size + ["-o", os.path.join(tmp, "t.pfm")],
+                          {"WAVEPATH_KERNEL_DIR": d})
+                rate[k].append(json.loads(out.stdout)["samples_per_second"])
+        now, arrays = statistics.median(rate["now"]), statistics.median(rate["arrays"])
+        name = os.path.basename(scene) if scene != scenes[1] else "Lambertian copy of " + \
+            os.path.basename(a.scene)
+        print(f"| {name} | {now:.4g} | {arrays:.4g} | {arrays / now:.3f} |")
+
+
 def run(wavepath, scene, args, env_extra):
     env = dict(os.environ, **env_extra)
     p = subprocess.run([wavepath, "render", scene, "-q", "--json"] + args,
@@ -138,13 +198,23 @@ def main():
     p.add_argument("--wavepath", default=os.path.join(ROOT, "build", "wavepath"))
     p.add_argument("--scene", default=os.path.join(ROOT, "scenes", "cornell_box.gltf"))
     p.add_argument("--size", type=int, default=512, help="square image side (default 512)")
-    p.add_argument("--spp", type=int, default=64, help="samples per pixel (default 64)")
+    p.add_argument("--spp", type=int,
+                   help="samples per pixel (default 64; 16 with --layout-cost)")
     p.add_argument("--rounds", type=int, default=5, help="alternated rounds (default 5)")
-    p.add_argument("--check", action="store_true", help="write the variants only, render nothing")
+    p.add_argument("--check", action="store_true",
+                   help="write the variants and the layout, build one variant (the ctest)")
+    p.add_argument("--layout-cost", action="store_true",
+                   help="time whole renders with the arrays layout (default --spp 16)")
     a = p.parse_args()
     device, row = vectorization.default_device(a.wavepath)
     if device is None or "Portable Computing Language" not in row:
         fail(f"wavepath's default device ({device or 'none'}) is not PoCL's", 77)
+    if a.layout_cost:
+        a.spp = a.spp or 16
+        with tempfile.TemporaryDirectory() as tmp:
+            layout_cost(a, tmp)
+        return
+    a.spp = a.spp or 64
     variants = [("real kernel", None)] + [(f"rng {r}, layout {l}", (r, l))
                                           for l in ("lanes", "arrays") for r in ("pair", "scalar")]
     with tempfile.TemporaryDirectory() as tmp:
@@ -155,6 +225,7 @@ def main():
                 dirs[name] = os.path.join(tmp, "%s-%s" % v)
                 make_variant(dirs[name], *v)
         if a.check:  # the variant the probe is about: it must still build and get a verdict
+            make_arrays_layout(os.path.join(tmp, "arrays"))
             name = "rng scalar, layout arrays"
             print(f"{name}: {verdict(a.wavepath, a.scene, dirs[name], tmp)}")
             return
