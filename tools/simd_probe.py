@@ -76,7 +76,8 @@ RNG = {
 
 LAYOUT = {
     "lanes": "#define F(field, lane) ((__global float*)(paths.field + slot))[lane]",
-    "arrays": "#define F(field, lane) ((__global float*)paths.field)[(lane) * launch.path_count + slot]",
+    "arrays": "#define F(field, lane) "
+              "((__global float*)paths.field)[(lane) * launch.path_count + slot]",
 }
 
 BODY = """WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, uint slot) {
@@ -118,7 +119,8 @@ def make_variant(folder, rng, layout):
     end = text.find(END, begin)
     if begin < 0 or end < 0:
         fail(f"{CAMERA} has no `{BEGIN}...`: the probe needs updating")
-    text = text[:begin] + BODY.replace("@RNG@", RNG[rng]).replace("@LAYOUT@", LAYOUT[layout]) + text[end + len(END):]
+    body = BODY.replace("@RNG@", RNG[rng]).replace("@LAYOUT@", LAYOUT[layout])
+    text = text[:begin] + body + text[end + len(END):]
     with open(path, "w") as f:
         f.write(text)
 
@@ -189,7 +191,10 @@ def verdict(wavepath, scene, kernel_dir, tmp):
     k = vectorization.analyse(p.stdout + p.stderr).get("generate_camera_rays")
     if not k:
         fail("no remarks for generate_camera_rays")
-    return vectorization.verdict(k) or "no verdict"
+    v = vectorization.verdict(k)
+    if not v:
+        fail("generate_camera_rays' work-item loop got no verdict")
+    return v
 
 
 def main():
