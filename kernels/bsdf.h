@@ -616,9 +616,9 @@ static inline void eval_layers(const Surface* s, float3 wo, float3 wi, float cos
 #endif
 
 /* What the BSDF at a surface needs of wo alone, worked out once per scattering event
- * (bsdf_view): the NEE evaluation, the lobe choice and the evaluation of the sampled direction
- * share it (each worked it out before, three times the same numbers per bounce). bsdf_eval and
- * bsdf_sample make their own. */
+ * (bsdf_view) and shared by the NEE evaluation, the lobe choice and the evaluation of the sampled
+ * direction, which would otherwise each work out the same numbers. bsdf_eval and bsdf_sample make
+ * their own. */
 typedef struct BsdfView {
   float cos_o; /* ns . wo */
 #if WP_FEATURE_GLOSSY

@@ -30,10 +30,11 @@ the same image bit for bit (checked).
   tools/simd_probe.py --layout-cost        the layout's cost to the whole pipeline (5 runs each
                                            of the Cornell box, its Lambertian copy and
                                            DamagedHelmet when ../shared/assets has it)
-  tools/simd_probe.py --check              the ctest: writes the variants and compiles one, which
-                                           must get a verdict (fails when the kernel no longer
-                                           has the text the probe replaces, or the probe no
-                                           longer builds); what LLVM decides is not asserted
+  tools/simd_probe.py --check              the ctest: writes the variants, applies the layout
+                                           patch and compiles one variant, which must get a
+                                           verdict (fails when the kernels no longer have what
+                                           the probe changes, or the probe no longer builds);
+                                           what LLVM decides is not asserted
 
 Exit status 0; 2 when wavepath fails, the kernel no longer has the text the probe replaces, or a
 variant gets no verdict; 77 (CTest's skip) when wavepath's default device is not PoCL's.
@@ -41,6 +42,7 @@ Standard library only.
 """
 
 import argparse
+import hashlib
 import json
 import os
 import shutil
@@ -49,8 +51,7 @@ import subprocess
 import sys
 import tempfile
 
-import hashlib
-
+import peers_scene
 import vectorization
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -139,18 +140,18 @@ def layout_cost(a, tmp):
     """Samples/s of whole renders, the kernels of the tree against the arrays layout."""
     dirs = {"now": KERNELS, "arrays": os.path.join(tmp, "arrays")}
     make_arrays_layout(dirs["arrays"])
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import peers_scene
-    scenes = [a.scene, os.path.join(tmp, "lambertian.gltf")]
-    peers_scene.lambertian_copy(a.scene, scenes[1])
+    lambertian = os.path.join(tmp, "lambertian.gltf")
+    peers_scene.lambertian_copy(a.scene, lambertian)
+    scenes = [(os.path.basename(a.scene), a.scene),
+              ("Lambertian copy of " + os.path.basename(a.scene), lambertian)]
     if os.path.exists(HELMET):
-        scenes.append(HELMET)
+        scenes.append((os.path.basename(HELMET), HELMET))
     size = ["--width", str(a.size), "--height", str(a.size), "--spp", str(a.spp)]
     print(f"Whole renders, {a.size} x {a.size} x {a.spp} spp, samples/s, medians of {a.rounds} "
           "alternated runs:\n")
     print("| scene | layout now | one array per component | ratio |")
     print("|---|--:|--:|--:|")
-    for scene in scenes:
+    for name, scene in scenes:
         rate = {k: [] for k in dirs}
         digest = {}
         for k, d in dirs.items():  # one unmeasured run each: the kernel caches
@@ -166,8 +167,6 @@ def layout_cost(a, tmp):
                           {"WAVEPATH_KERNEL_DIR": d})
                 rate[k].append(json.loads(out.stdout)["samples_per_second"])
         now, arrays = statistics.median(rate["now"]), statistics.median(rate["arrays"])
-        name = os.path.basename(scene) if scene != scenes[1] else "Lambertian copy of " + \
-            os.path.basename(a.scene)
         print(f"| {name} | {now:.4g} | {arrays:.4g} | {arrays / now:.3f} |")
 
 
