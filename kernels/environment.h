@@ -16,6 +16,7 @@
  *     (x = -1 is W - 1, x = W is 0). Rows clamp at the poles (y = -1 is 0, y = H is H - 1): within
  *     half a texel of a pole the map is interpolated along u only, so the pole value depends on
  *     the direction of approach as it does with nearest lookup (the pole is a null set).
+ * The two atan2 are atan2_poly's (sampling.h), which PoCL inlines.
  *
  * Sampling tables (host/lights/environment.cpp fills them), float CDFs, built for the filter:
  *   env_marginal[0..H]: over rows; [0] = 0, [H] = 1, row y has probability
@@ -74,8 +75,9 @@ static inline float env_texel_pdf(float p, uint w, uint h, float sin_theta) {
 /* Texel (x, y) seen along map-frame direction m (any length); *sin_theta gets its sin(theta). */
 static inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
   const float r_xz = sqrt(m.x * m.x + m.z * m.z);
-  const float u = fmax(0.0f, atan2(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
-  const float v = atan2(r_xz, m.y) * WP_INV_PI; /* well conditioned at the poles, unlike acos */
+  const float u = fmax(0.0f, atan2_poly(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
+  /* theta by atan2: well conditioned at the poles, unlike acos */
+  const float v = atan2_poly(r_xz, m.y) * WP_INV_PI;
   *sin_theta = r_xz / length(m);
   return (uint2)(min((uint)(u * (float)d->env_width), d->env_width - 1u),
                  min((uint)(v * (float)d->env_height), d->env_height - 1u));
@@ -117,8 +119,8 @@ static inline float3 env_bilinear(const SceneView* scene, float u, float v) {
 static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
   const SceneDesc* d = scene->desc;
   const float3 m = env_to_map(d, dir);
-  const float u = fmax(0.0f, atan2(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
-  const float v = atan2(sqrt(m.x * m.x + m.z * m.z), m.y) * WP_INV_PI;
+  const float u = fmax(0.0f, atan2_poly(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
+  const float v = atan2_poly(sqrt(m.x * m.x + m.z * m.z), m.y) * WP_INV_PI;
   return env_bilinear(scene, u, v) * d->env_params.x;
 }
 #else
@@ -156,14 +158,14 @@ static inline float3 env_map_sample(const SceneView* scene, float2 u, float3* di
   /* Remainders within the chosen intervals: uniform in [0, 1) given the choice. */
   const float fy = fmin((ux - marginal[y]) / p_row, WP_ENV_BELOW_ONE);
   const float fx = fmin((uy - row[x]) / p_col, WP_ENV_BELOW_ONE);
-  const float theta = WP_PI * (((float)y + fy) / (float)h);
-  const float phi = 2.0f * WP_PI * (((float)x + fx) / (float)w) - WP_PI;
-  const float sin_theta = sin(theta);
-  *dir = env_from_map(d, (float3)(sin_theta * sin(phi), cos(theta), -sin_theta * cos(phi)));
-  *pdf = env_texel_pdf(p_row * p_col, w, h, sin_theta);
+  /* The point (u, v) of the map: theta = pi v, phi = 2 pi u - pi, whose cosine and sine are
+   * those of 2 pi u with the signs flipped. */
+  const float mu = ((float)x + fx) / (float)w, mv = ((float)y + fy) / (float)h;
+  const float2 theta = cos_sin_turn(0.5f * mv), phi = -cos_sin_turn(mu);
+  *dir = env_from_map(d, (float3)(theta.y * phi.y, theta.x, -theta.y * phi.x));
+  *pdf = env_texel_pdf(p_row * p_col, w, h, theta.y);
 #if WP_ENV_BILINEAR
-  return env_bilinear(scene, ((float)x + fx) / (float)w, ((float)y + fy) / (float)h) *
-         d->env_params.x;
+  return env_bilinear(scene, mu, mv) * d->env_params.x;
 #else
   return scene->env_texels[y * w + x].xyz * d->env_params.x;
 #endif

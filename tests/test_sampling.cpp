@@ -536,6 +536,61 @@ TEST(Sampling, CosSinTurn) {
   }
 }
 
+// atan2_poly (kernels/sampling.h), the atan2 of the environment map's lookup: against double
+// precision atan2 of the same floats, at 2^20 angles around the circle (each at radii from 1e-30
+// to 1e30, where the quotient min/max must not lose its precision), densely near the octant
+// boundaries |x| = |y| where the reflection pi/2 - r takes over, and on the axes with both signed
+// zeros. The bound, summed over the steps: the quotient a = min/max rounds by at most 2^-24 a
+// (6e-8 in the angle, as atan' <= 1); the polynomial with float coefficients, evaluated by Horner
+// in float, is within 1.1e-7 of atan on [0, 1] (tools/gen_atan_poly.py, at 4 million points);
+// pi/2 - r and pi - r round by at most half an ulp of results below 2 and 4 (6e-8, 1.2e-7) with
+// the float constants pi/2 and pi off by 4.4e-8 and 8.8e-8: 4.8e-7 in all. Exact where the
+// octant's angle is: 0, +-pi/2 and +-pi on the axes (float pi/2 and pi, as the library gives),
+// with atan2's signs of zero.
+TEST(Sampling, Atan2Poly) {
+  wp::test::KernelHarness h({"trig_kernels.cl"});
+  std::vector<cl_float2> yx;  // (y, x)
+  constexpr int kAngles = 1 << 20;
+  const double two_pi = 2.0 * kPi;
+  const float kPiF = static_cast<float>(kPi);
+  const float radii[] = {1e-30f, 1e-3f, 1.0f, 7.5f, 1e30f};
+  for (int i = 0; i < kAngles; ++i) {
+    const double t = two_pi * (i + 0.5) / kAngles;
+    const float r = radii[i % 5];
+    yx.push_back({{static_cast<float>(r * std::sin(t)), static_cast<float>(r * std::cos(t))}});
+  }
+  for (float sy : {1.0f, -1.0f})  // |y| = |x| and its float neighbours
+    for (float sx : {1.0f, -1.0f}) {
+      float y = 0.75f;
+      for (int step = 0; step < 8; ++step) y = std::nextafter(y, 0.0f);
+      for (int step = 0; step < 17; ++step, y = std::nextafter(y, 1.0f))
+        yx.push_back({{sy * y, sx * 0.75f}});
+    }
+  const std::size_t axes = yx.size();
+  const float axis_points[][3] = {// y, x, expected
+                                  {0.0f, 1.0f, 0.0f},         {-0.0f, 1.0f, -0.0f},
+                                  {0.0f, -1.0f, kPiF},        {-0.0f, -1.0f, -kPiF},
+                                  {1.0f, 0.0f, 0.5f * kPiF},  {-1.0f, 0.0f, -0.5f * kPiF},
+                                  {1.0f, -0.0f, 0.5f * kPiF}, {0.0f, 0.0f, 0.0f},
+                                  {0.0f, -0.0f, kPiF},        {-0.0f, -0.0f, -kPiF}};
+  for (const auto& p : axis_points) yx.push_back({{p[0], p[1]}});
+  const auto count = static_cast<std::uint32_t>(yx.size());
+  cl::Buffer in = h.buffer(yx), out = h.buffer<float>(count);
+  h.run("atan2_poly_at", count, in, count, out);
+  const auto v = h.read<float>(out, count);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < axes; ++i)
+    worst = std::max(worst, std::fabs(v[i] - std::atan2(double(yx[i].s[0]), double(yx[i].s[1]))));
+  std::cout << "  atan2_poly: largest error " << worst << " over " << axes << " points\n";
+  EXPECT_LE(worst, 4.8e-7);
+  for (std::size_t k = 0; k < std::size(axis_points); ++k) {
+    const float got = v[axes + k], want = axis_points[k][2];
+    EXPECT_EQ(got, want) << "atan2_poly(" << axis_points[k][0] << ", " << axis_points[k][1] << ")";
+    EXPECT_EQ(std::signbit(got), std::signbit(want))
+        << "atan2_poly(" << axis_points[k][0] << ", " << axis_points[k][1] << ")";
+  }
+}
+
 // The thin lens's disc sampler (kernels/camera.h): uniform on the unit disc, pdf 1/pi. Binned into
 // 16 rings of equal area (r^2 in steps of 1/16) x 32 sectors, each of probability 1/512, from 2^20
 // independent points of the square (a host Mersenne Twister, so the counts are multinomial and
