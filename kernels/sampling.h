@@ -4,6 +4,7 @@
 #define WP_SAMPLING_H
 
 #include "common.h"
+#include "elementary.h"
 
 /* (cos t, sin t) for |t| <= pi/4, by their Taylor polynomials to t^10 and t^9: the remainders are
  * below (pi/4)^12 / 12! = 1.1e-10 and (pi/4)^11 / 11! = 1.8e-9, far under float's rounding, so
@@ -32,34 +33,6 @@ static inline float2 cos_sin_turn(float u) {
   const float c = k == 0 ? cs.x : k == 1 ? -cs.y : k == 2 ? -cs.x : cs.y;
   const float s = k == 0 ? cs.y : k == 1 ? cs.x : k == 2 ? -cs.y : -cs.x;
   return (float2)(c, s);
-}
-
-/* atan2(y, x) in [-pi, pi], without the library's call (PoCL keeps atan2 out of line with its
- * argument reduction: an environment map's lookup at every escaped ray took 12% of a render of an
- * environment-lit model there, docs/performance.md). The angle of the smaller coordinate over the
- * larger, a = min(|x|, |y|) / max(|x|, |y|) in [0, 1], from a P(a^2), P of degree 8 fitted to atan
- * on [0, 1] (tools/gen_atan_poly.py: 5.8e-9 at worst, 1.1e-7 with float coefficients and Horner
- * in float), moved to its octant: pi/2 - r where |y| > |x|, pi - r where x's sign bit is set
- * (x = -0 too, as IEEE's atan2), then the sign of y. (0, 0) gives 0 or pi with y's sign; x and y
- * finite. */
-static inline float atan2_poly(float y, float x) {
-  const float ax = fabs(x), ay = fabs(y);
-  const bool steep = ay > ax;
-  const float hi = steep ? ay : ax, lo = steep ? ax : ay;
-  const float a = hi > 0.0f ? lo / hi : 0.0f;
-  const float s = a * a;
-  const float p = 9.999998808e-01f +
-                  s * (-3.333259821e-01f +
-                       s * (1.998590678e-01f +
-                            s * (-1.416122913e-01f +
-                                 s * (1.049894616e-01f +
-                                      s * (-7.234857976e-02f +
-                                           s * (3.978122771e-02f + s * (-1.440135855e-02f +
-                                                                        s * 2.456724877e-03f)))))));
-  float r = a * p;
-  r = steep ? 0.5f * WP_PI - r : r;
-  r = signbit(x) ? WP_PI - r : r;
-  return copysign(r, y);
 }
 
 /* Uniform on the unit disk (Shirley and Chiu's concentric mapping of the square, area-preserving):

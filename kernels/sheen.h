@@ -44,6 +44,8 @@
  * (1 + Lambda_o + Lambda_i) underflows, for (n.wo)(n.wi) below ~1e-47; sheen_eval then returns
  * FLT_MAX, not inf (the true value is beyond float32 there). Where |wo + wi|^2 underflows (both
  * within 1e-19 of the horizon and opposite) h has no float32 direction and sheen_eval returns 0.
+ * exp, log, log1p, pow and cbrt are elementary.h's inlined polynomials, within OpenCL's bounds for
+ * the library's (PoCL's out-of-line calls took 19.5% of a render of SheenChair).
  *
  * WP_SHEEN_ROUGHNESS_MIN = 0.07 (alpha 0.0049). Below it E keeps growing, like ~0.2 / roughness
  * (6.4 at roughness 0.03, 18 at 0.01), with features of width ~roughness in mu, too fine for the
@@ -57,6 +59,7 @@
 #define WP_SHEEN_H
 
 #include "common.h"
+#include "elementary.h"
 #include "sheen_table.h"
 
 #define WP_SHEEN_ROUGHNESS_MIN 0.07f
@@ -76,7 +79,7 @@ static inline float sheen_alpha(float roughness) {
 static inline float sheen_d_log(float log_sin2, float alpha) {
   alpha = sheen_clamp_alpha(alpha);
   const float inv = 1.0f / alpha;
-  return (2.0f + inv) * (0.5f * WP_INV_PI) * exp(fmin(log_sin2, 0.0f) * (0.5f * inv));
+  return (2.0f + inv) * (0.5f * WP_INV_PI) * exp_poly(fmin(log_sin2, 0.0f) * (0.5f * inv));
 }
 
 /* D(h) for h at cosine cos_h to the normal. */
@@ -84,7 +87,7 @@ static inline float sheen_d(float cos_h, float alpha) {
   const float c = fmin(fabs(cos_h), 1.0f);
   const float c2 = c * c;
   /* 1 - c is exact for c >= 0.5, so (1 - c)(1 + c) keeps sin^2's relative precision there. */
-  const float log_sin2 = c2 < 0.5f ? log1p(-c2) : log((1.0f - c) * (1.0f + c));
+  const float log_sin2 = c2 < 0.5f ? log1p_poly(-c2) : log_poly((1.0f - c) * (1.0f + c));
   return sheen_d_log(log_sin2, alpha);
 }
 
@@ -94,7 +97,7 @@ typedef struct SheenFit {
 } SheenFit;
 
 static inline float sheen_l(float x, const SheenFit* f) {
-  return f->a / (1.0f + f->b * pow(x, f->c)) + f->d * x + f->e;
+  return f->a / (1.0f + f->b * powr_poly(x, f->c)) + f->d * x + f->e;
 }
 
 static inline SheenFit sheen_fit(float alpha) {
@@ -111,7 +114,7 @@ static inline SheenFit sheen_fit(float alpha) {
 
 static inline float sheen_lambda_fit(float cos_theta, const SheenFit* f) {
   const float c = fmin(fabs(cos_theta), 1.0f); /* fmin(NaN, 1) = 1 */
-  return c < 0.5f ? exp(sheen_l(c, f)) : exp(2.0f * f->l_half - sheen_l(1.0f - c, f));
+  return c < 0.5f ? exp_poly(sheen_l(c, f)) : exp_poly(2.0f * f->l_half - sheen_l(1.0f - c, f));
 }
 
 /* Lambda(cos_theta) of the fitted visibility. */
@@ -130,10 +133,10 @@ static inline float sheen_eval(float3 n, float3 wo, float3 wi, float alpha) {
   const float cos2 = sqr(cos_o + cos_i) / len2;
   float log_sin2;
   if (cos2 < 0.5f) {
-    log_sin2 = log1p(-cos2);
+    log_sin2 = log1p_poly(-cos2);
   } else {
     const float3 x = cross(n, s);
-    log_sin2 = log(dot(x, x) / len2);
+    log_sin2 = log_poly(dot(x, x) / len2);
   }
   const float d = sheen_d_log(log_sin2, alpha);
   if (!(d > 0.0f)) return 0.0f;
@@ -147,7 +150,7 @@ static inline float sheen_eval(float3 n, float3 wo, float3 wi, float alpha) {
  * (cbrt(mu), sqrt(roughness)): mu clamped into [0, 1], roughness into [WP_SHEEN_ROUGHNESS_MIN, 1]
  * (a NaN becomes 0 or the minimum). Below mu = 1/31^3 the table is flat (sheen_table.h). */
 static inline float sheen_albedo(float mu, float roughness) {
-  const float x = cbrt(fmin(fmax(mu, 0.0f), 1.0f)) * (float)(WP_SHEEN_TABLE_NMU - 1);
+  const float x = cbrt_poly(fmin(fmax(mu, 0.0f), 1.0f)) * (float)(WP_SHEEN_TABLE_NMU - 1);
   const float r = fmin(fmax(roughness, WP_SHEEN_ROUGHNESS_MIN), 1.0f);
   const float y =
       fmax(0.0f, (sqrt(r) - WP_SHEEN_TABLE_SQRT_RMIN) *

@@ -591,6 +591,167 @@ TEST(Sampling, Atan2Poly) {
   }
 }
 
+// The other functions of kernels/elementary.h against double precision: each at 2^20 or more
+// arguments, its error in u = 2^-24 relative to the exact value (half an ulp), against the bound
+// that header states, derived here from its steps (a correctly rounded + - * / rounds by at most u
+// relative; Taylor and series remainders as that header gives them), and its special values.
+class Elementary : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { h_ = new wp::test::KernelHarness({"trig_kernels.cl"}); }
+  static void TearDownTestSuite() {
+    delete h_;
+    h_ = nullptr;
+  }
+  // fn (elementary_at's numbering) at each (x, y).
+  static std::vector<float> run(std::uint32_t fn, const std::vector<cl_float2>& in) {
+    const auto count = static_cast<std::uint32_t>(in.size());
+    cl::Buffer b = h_->buffer(in), out = h_->buffer<float>(count);
+    h_->run("elementary_at", count, b, count, fn, out);
+    return h_->read<float>(out, count);
+  }
+  // Positive finite floats with uniformly random bit patterns in [lo, hi] (all binades alike).
+  static std::vector<cl_float2> random_bits(float lo, float hi, std::uint32_t n,
+                                            std::uint32_t seed) {
+    std::uint32_t a, b;
+    std::memcpy(&a, &lo, 4), std::memcpy(&b, &hi, 4);
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<std::uint32_t> bits(a, b);
+    std::vector<cl_float2> v(n);
+    for (auto& p : v) {
+      const std::uint32_t w = bits(rng);
+      std::memcpy(&p.s[0], &w, 4);
+      p.s[1] = 0.0f;
+    }
+    return v;
+  }
+  static double error_u(float got, double exact) {
+    return std::fabs(double(got) - exact) / (std::fabs(exact) * 0x1p-24);
+  }
+  static wp::test::KernelHarness* h_;
+};
+wp::test::KernelHarness* Elementary::h_ = nullptr;
+
+// exp_poly. n ln2_hi is exact and x - n ln2_hi too (Sterbenz: x and n ln2_hi are within a factor 2
+// where n != 0); ln2_lo's product and the subtraction round r by u |r| and ln2_hi + ln2_lo is off
+// ln 2 by 5e-15, |n| <= 128 times: e^r moves by u |r| <= 0.35 u. The Taylor remainder is below
+// 1.1e-8 = 0.18 u relative. Horner's steps p_k = c_k + r p_(k+1): each rounds by u of its value,
+// and the error of p_(k+1) reaches p_k scaled by |r p_(k+1) / p_k| <= 0.35 / 0.7 (inner steps
+// smaller still): the last two steps' u each plus the geometric rest, under 2.3 u; the powers of
+// two are exact: 0.35 + 0.18 + 2.3 < 3 u. Arguments from -87.3 to 88.7 (results normal), and
+// below, where the results are subnormal.
+TEST_F(Elementary, Exp) {
+  std::vector<cl_float2> in;
+  constexpr int kN = 1 << 20;
+  for (int i = 0; i < kN; ++i)
+    in.push_back({{-87.3f + 176.0f * (static_cast<float>(i) + 0.5f) / kN, 0.0f}});
+  for (int i = 0; i < 4096; ++i) in.push_back({{std::ldexp(float(i) - 2048.0f, -30), 0.0f}});
+  const std::vector<float> v = run(0, in);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < in.size(); ++i)
+    worst = std::max(worst, error_u(v[i], std::exp(double(in[i].s[0]))));
+  std::cout << "  exp_poly: largest error " << worst << " u over " << in.size() << " points\n";
+  EXPECT_LE(worst, 3.0);
+  // Subnormal results (x from -103.97 to -87.34): the normal result's 3 u plus the last product's
+  // rounding to a multiple of 2^-149.
+  std::vector<cl_float2> low;
+  for (int i = 0; i <= 1000; ++i)
+    low.push_back({{-103.9f + 16.5f * static_cast<float>(i) / 1000, 0}});
+  const std::vector<float> lv = run(0, low);
+  for (std::size_t i = 0; i < low.size(); ++i) {
+    const double exact = std::exp(double(low[i].s[0]));
+    EXPECT_LE(std::fabs(lv[i] - exact), 3.0 * 0x1p-24 * exact + 0x1p-150) << "x " << low[i].s[0];
+  }
+  const float inf = INFINITY;
+  const std::vector<float> special =
+      run(0, {{{0.0f, 0}}, {{-inf, 0}}, {{inf, 0}}, {{NAN, 0}}, {{88.8f, 0}}, {{-104.0f, 0}}});
+  EXPECT_EQ(special[0], 1.0f);
+  EXPECT_EQ(special[1], 0.0f);
+  EXPECT_EQ(special[2], inf);
+  EXPECT_TRUE(std::isnan(special[3]));
+  EXPECT_EQ(special[4], inf);
+  EXPECT_EQ(special[5], 0.0f);
+}
+
+// log_poly. m - 1 is exact; s = f / (2 + f) rounds twice (2 u relative); the series' remainder is
+// below 3e-11, and 1 + q with q <= 0.0099 carries s's error and the sum's u: ln m within 3.1 u
+// relative (2 s q adds u q). With e != 0 the sum's two steps round by u of |e ln 2| and of the
+// result, and |ln m| <= ln(2) / 2 <= |result| keeps ln m's 3.1 u below 3.1 u of the result: within
+// 4 u where e != 0 and 3.1 u where e = 0. Over every binade of positive floats, subnormals
+// included, and densely near 1, where the result is smallest.
+TEST_F(Elementary, Log) {
+  std::vector<cl_float2> in = random_bits(1e-45f, 3.4e38f, 1 << 20, 20261127);
+  for (int i = -4096; i <= 4096; ++i)
+    if (i != 0) in.push_back({{1.0f + std::ldexp(float(i), -23), 0.0f}});
+  const std::vector<float> v = run(1, in);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < in.size(); ++i)
+    worst = std::max(worst, error_u(v[i], std::log(double(in[i].s[0]))));
+  std::cout << "  log_poly: largest error " << worst << " u over " << in.size() << " points\n";
+  EXPECT_LE(worst, 4.0);
+  const float inf = INFINITY;
+  const std::vector<float> special =
+      run(1, {{{1.0f, 0}}, {{0.0f, 0}}, {{inf, 0}}, {{-1.0f, 0}}, {{NAN, 0}}});
+  EXPECT_EQ(special[0], 0.0f);
+  EXPECT_EQ(special[1], -inf);
+  EXPECT_EQ(special[2], inf);
+  EXPECT_TRUE(std::isnan(special[3]));
+  EXPECT_TRUE(std::isnan(special[4]));
+}
+
+// log1p_poly on (-1/2, 1/2), where the kernels use it: s = y / (2 + y) rounds twice (2 u), the
+// series to s^17 leaves 1e-10 and 1 + q (q <= 0.038) adds u: within 3.1 u, as log_poly's e = 0
+// case. Uniform over the interval and at tiny arguments of both signs (where 1 + y rounds to 1).
+TEST_F(Elementary, Log1p) {
+  std::vector<cl_float2> in;
+  constexpr int kN = 1 << 20;
+  for (int i = 0; i < kN; ++i) in.push_back({{-0.5f + (static_cast<float>(i) + 0.5f) / kN, 0.0f}});
+  for (int e = -126; e < -1; ++e)
+    for (float sign : {1.0f, -1.0f}) in.push_back({{sign * std::ldexp(1.3f, e), 0.0f}});
+  const std::vector<float> v = run(2, in);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < in.size(); ++i)
+    worst = std::max(worst, error_u(v[i], std::log1p(double(in[i].s[0]))));
+  std::cout << "  log1p_poly: largest error " << worst << " u over " << in.size() << " points\n";
+  EXPECT_LE(worst, 4.0);
+  const std::vector<float> zero = run(2, {{{0.0f, 0}}, {{-0.0f, 0}}});
+  EXPECT_EQ(zero[0], 0.0f);
+  EXPECT_TRUE(std::signbit(zero[1]));
+}
+
+// powr_poly(x, c) = exp_poly(c log_poly(x)): log's 4 u and the product's u make the exponent t
+// off by 5 u |t| (absolute), which e^t turns into 5 u |t| relative, and exp's own 3 u: within
+// (3 + 5 |c ln x|) u. cbrt_poly likewise with c = 1/3 rounded (u relative more in t): within
+// (3 + 6 |ln x| / 3) u. x over (0, 1] (every binade) with c in [0.1, 0.3], as sheen's fit takes;
+// cube roots over all positive floats; and x = 0.
+TEST_F(Elementary, PowrAndCbrt) {
+  std::vector<cl_float2> in = random_bits(1e-45f, 1.0f, 1 << 20, 7);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> exponent(0.1f, 0.3f);
+  for (auto& p : in) p.s[1] = exponent(rng);
+  const std::vector<float> v = run(3, in);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const double x = in[i].s[0], c = in[i].s[1];
+    const double bound = 3.0 + 5.0 * std::fabs(c * std::log(x));
+    worst = std::max(worst, error_u(v[i], std::pow(x, c)) / bound);
+  }
+  std::cout << "  powr_poly: largest error " << worst << " of the bound\n";
+  EXPECT_LE(worst, 1.0);
+  const std::vector<cl_float2> roots = random_bits(1e-45f, 3.4e38f, 1 << 20, 13);
+  const std::vector<float> r = run(4, roots);
+  worst = 0.0;
+  for (std::size_t i = 0; i < roots.size(); ++i) {
+    const double x = roots[i].s[0];
+    const double bound = 3.0 + 6.0 * std::fabs(std::log(x)) / 3.0;
+    worst = std::max(worst, error_u(r[i], std::cbrt(x)) / bound);
+  }
+  std::cout << "  cbrt_poly: largest error " << worst << " of the bound\n";
+  EXPECT_LE(worst, 1.0);
+  const std::vector<float> zero = run(3, {{{0.0f, 0.2f}}});
+  EXPECT_EQ(zero[0], 0.0f);
+  EXPECT_EQ(run(4, {{{0.0f, 0}}, {{1.0f, 0}}, {{8.0f, 0}}})[0], 0.0f);
+}
+
 // The thin lens's disc sampler (kernels/camera.h): uniform on the unit disc, pdf 1/pi. Binned into
 // 16 rings of equal area (r^2 in steps of 1/16) x 32 sectors, each of probability 1/512, from 2^20
 // independent points of the square (a host Mersenne Twister, so the counts are multinomial and
