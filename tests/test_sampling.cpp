@@ -627,6 +627,17 @@ class Elementary : public ::testing::Test {
   static double error_u(float got, double exact) {
     return std::fabs(double(got) - exact) / (std::fabs(exact) * 0x1p-24);
   }
+  // The largest error_u of fn at the x of each argument against exact, printed with `name`.
+  static double worst_u(std::uint32_t fn, const std::vector<cl_float2>& in, double (*exact)(double),
+                        const char* name) {
+    const std::vector<float> v = run(fn, in);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < in.size(); ++i)
+      worst = std::max(worst, error_u(v[i], exact(double(in[i].s[0]))));
+    std::cout << "  " << name << ": largest error " << worst << " u over " << in.size()
+              << " points\n";
+    return worst;
+  }
   static wp::test::KernelHarness* h_;
 };
 wp::test::KernelHarness* Elementary::h_ = nullptr;
@@ -645,12 +656,9 @@ TEST_F(Elementary, Exp) {
   for (int i = 0; i < kN; ++i)
     in.push_back({{-87.3f + 176.0f * (static_cast<float>(i) + 0.5f) / kN, 0.0f}});
   for (int i = 0; i < 4096; ++i) in.push_back({{std::ldexp(float(i) - 2048.0f, -30), 0.0f}});
-  const std::vector<float> v = run(0, in);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < in.size(); ++i)
-    worst = std::max(worst, error_u(v[i], std::exp(double(in[i].s[0]))));
-  std::cout << "  exp_poly: largest error " << worst << " u over " << in.size() << " points\n";
-  EXPECT_LE(worst, 3.0);
+  EXPECT_LE(worst_u(
+                0, in, [](double x) { return std::exp(x); }, "exp_poly"),
+            3.0);
   // Subnormal results (x from -103.97 to -87.34): the normal result's 3 u plus the last product's
   // rounding to a multiple of 2^-149.
   std::vector<cl_float2> low;
@@ -682,12 +690,9 @@ TEST_F(Elementary, Log) {
   std::vector<cl_float2> in = random_bits(1e-45f, 3.4e38f, 1 << 20, 20261127);
   for (int i = -4096; i <= 4096; ++i)
     if (i != 0) in.push_back({{1.0f + std::ldexp(float(i), -23), 0.0f}});
-  const std::vector<float> v = run(1, in);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < in.size(); ++i)
-    worst = std::max(worst, error_u(v[i], std::log(double(in[i].s[0]))));
-  std::cout << "  log_poly: largest error " << worst << " u over " << in.size() << " points\n";
-  EXPECT_LE(worst, 4.0);
+  EXPECT_LE(worst_u(
+                1, in, [](double x) { return std::log(x); }, "log_poly"),
+            4.0);
   const float inf = INFINITY;
   const std::vector<float> special =
       run(1, {{{1.0f, 0}}, {{0.0f, 0}}, {{inf, 0}}, {{-1.0f, 0}}, {{NAN, 0}}});
@@ -707,12 +712,9 @@ TEST_F(Elementary, Log1p) {
   for (int i = 0; i < kN; ++i) in.push_back({{-0.5f + (static_cast<float>(i) + 0.5f) / kN, 0.0f}});
   for (int e = -126; e < -1; ++e)
     for (float sign : {1.0f, -1.0f}) in.push_back({{sign * std::ldexp(1.3f, e), 0.0f}});
-  const std::vector<float> v = run(2, in);
-  double worst = 0.0;
-  for (std::size_t i = 0; i < in.size(); ++i)
-    worst = std::max(worst, error_u(v[i], std::log1p(double(in[i].s[0]))));
-  std::cout << "  log1p_poly: largest error " << worst << " u over " << in.size() << " points\n";
-  EXPECT_LE(worst, 4.0);
+  EXPECT_LE(worst_u(
+                2, in, [](double x) { return std::log1p(x); }, "log1p_poly"),
+            4.0);
   const std::vector<float> zero = run(2, {{{0.0f, 0}}, {{-0.0f, 0}}});
   EXPECT_EQ(zero[0], 0.0f);
   EXPECT_TRUE(std::signbit(zero[1]));
