@@ -607,6 +607,37 @@ Rgba box_of_level0(const wp::Image& img, int level, int i, int j, bool srgb) {
   return sum;
 }
 
+// The chains' colour encoding from its table (encode_srgb8) against the pow form it replaces
+// (encode_srgb8_pow): the same code for one float in 256 across [0, 1] by bit pattern (every
+// binade), for the 16 floats around each code's first value (where the table's bisection
+// decides), and outside [0, 1] (clamped).
+TEST(MipChain, ColourEncodingMatchesThePowForm) {
+  const auto bits_to_float = [](std::uint32_t b) {
+    float f;
+    std::memcpy(&f, &b, sizeof f);
+    return f;
+  };
+  std::size_t checked = 0, mismatches = 0;
+  const auto check = [&](float v) {
+    ++checked;
+    if (wp::encode_srgb8(v) != wp::encode_srgb8_pow(v) && ++mismatches <= 10)
+      ADD_FAILURE() << "v " << v << ": table " << int(wp::encode_srgb8(v)) << ", pow "
+                    << int(wp::encode_srgb8_pow(v));
+  };
+  for (std::uint32_t b = 0; b <= 0x3f800000u; b += 256) check(bits_to_float(b));
+  for (int c = 0; c < 255; ++c) {  // each code's first value, by bisection on the pow form
+    std::uint32_t lo = 0, hi = 0x3f800000u;
+    while (hi - lo > 1) {
+      const std::uint32_t mid = lo + (hi - lo) / 2;
+      (wp::encode_srgb8_pow(bits_to_float(mid)) > c ? hi : lo) = mid;
+    }
+    for (std::uint32_t b = hi - 8; b < hi + 8; ++b) check(bits_to_float(b));
+  }
+  for (float v : {-1.0f, -0.0f, 1.0f, 1.5f, 1e30f}) check(v);
+  EXPECT_EQ(mismatches, 0u) << "of " << checked;
+  EXPECT_EQ(wp::encode_srgb8(0.5f), 188);  // the standard's 0.5 linear: 0.7354 encoded
+}
+
 // Every texel of every level, for odd, even, square and strip sizes, colour and data: each is the
 // 8-bit encoding, rounded to nearest, of the box filter of level 0 over its footprint, computed
 // here in double from level 0. The chain is made in float (each level from the previous one,

@@ -22,12 +22,22 @@ int wrap_texel(long long i, int n, Wrap mode) {
   return static_cast<int>(m < 0 ? m + n : m);
 }
 
+// The values of the 256 codes, decoded (srgb) or not: made once, not per triangle (a 46,000
+// triangle emitter made them 46,000 times, a tenth of DamagedHelmet's start-up).
+const std::array<double, 256>& decode_table(bool srgb) {
+  static const auto make = [](bool s) {
+    std::array<double, 256> t{};
+    for (int c = 0; c < 256; ++c) t[std::size_t(c)] = s ? srgb_to_linear(c / 255.0) : c / 255.0;
+    return t;
+  };
+  static const std::array<double, 256> colour = make(true), data = make(false);
+  return srgb ? colour : data;
+}
+
 // A texture's image with its decoding, for lookups by texel index.
 class TexelReader {
  public:
-  TexelReader(const Image& img, bool srgb) : img_(img) {
-    for (int c = 0; c < 256; ++c) decode_[c] = srgb ? srgb_to_linear(c / 255.0) : c / 255.0;
-  }
+  TexelReader(const Image& img, bool srgb) : img_(img), decode_(decode_table(srgb)) {}
   glm::dvec3 fetch(int x, int y) const {
     const std::uint8_t* p = &img_.rgba[4 * (static_cast<std::size_t>(y) * img_.width + x)];
     return {decode_[p[0]], decode_[p[1]], decode_[p[2]]};
@@ -35,7 +45,7 @@ class TexelReader {
 
  private:
   const Image& img_;
-  std::array<double, 256> decode_{};
+  const std::array<double, 256>& decode_;
 };
 
 // The texture at texture-space point (x, y) = uv x size, filtered as the kernels filter.

@@ -34,4 +34,10 @@ int mip_size(int size, int level);
 // colour images (RGB sRGB-encoded, alpha linear).
 std::vector<std::uint8_t> mip_chain(const Image& image, bool srgb);
 
+// The 8-bit sRGB code of linear value v (clamped to [0, 1]) as the chains encode colour:
+// round(255 linear_to_srgb(v)) (host/scene/srgb.h), computed with pow by encode_srgb8_pow and from
+// a table of the codes' first values by encode_srgb8, which gives the same code for every float.
+std::uint8_t encode_srgb8(float v);
+std::uint8_t encode_srgb8_pow(double v);
+
 }  // namespace wp
