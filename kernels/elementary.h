@@ -1,10 +1,12 @@
-/* Elementary functions without the library's calls. PoCL compiles exp, log, pow, cbrt and atan2
- * into calls to out-of-line routines (with argument reductions for any input and special-case
- * handling), and with them in the shading kernel a render spent 12-20% of its time in those calls
- * (docs/performance.md, "Environment lookups without library calls", "Sheen without library
- * calls"). These are inlined polynomials for the arguments the kernels pass, each with its error
- * bound, checked against double precision by tests/test_sampling.cpp (Elementary.*; u = 2^-24,
- * float's unit roundoff, is half an ulp relative):
+/* Elementary functions without the library's calls. PoCL compiles OpenCL's transcendental
+ * builtins (exp, log, pow, cbrt, atan2, cos, ...) into calls to out-of-line routines (with argument
+ * reductions for any input and special-case handling), and with them in the shading kernel a
+ * render spent 12-20% of its time in those calls (docs/performance.md, "Environment lookups without
+ * library calls", "Sheen without library calls"). No kernel calls them now
+ * (tests/test_kernel_tree.cpp, KernelSources.NoTranscendentalLibraryCalls); these are inlined
+ * polynomials for the arguments the kernels pass, each with its error bound, checked against double
+ * precision by tests/test_sampling.cpp (Elementary.*, Sampling.Atan2Poly, Sampling.CosSinTurn;
+ * u = 2^-24, float's unit roundoff, is half an ulp relative):
  *
  *   exp_poly(x)      e^x, within 3 u where it is a normal float (subnormal results round once
  *                    more, as the library's may), 0 below x = -103.97, +inf from 88.73 on, NaN
@@ -14,10 +16,13 @@
  *                    (-1/2, 0]); log_poly(1 + y) elsewhere
  *   powr_poly(x, c)  x^c for x >= 0 as e^(c ln x): within (3 + 5 |c ln x|) u, 0 at x = 0 for c > 0
  *   cbrt_poly(x)     the cube root for x >= 0, as e^(ln(x) / 3): within (3 + 6 |ln x| / 3) u
+ *   log2_poly(x)     log2 x, as log_poly(x) / ln 2, within 5 u
+ *   cos_sin_turn(u)  (cos 2 pi u, sin 2 pi u) for u in [0, 1], within 4e-7 absolute
+ *   cos_poly(x)      cos x for finite x, within 4e-7 + 1.2e-7 |x| absolute
  *   atan2_poly(y, x) atan2, within 4.8e-7 absolute
  *
- * The ranges of exp and log are reduced with Cody and Waite's split of ln 2: ln2_hi has 16
- * significant bits, so n ln2_hi is exact for |n| < 256 and x - n ln2_hi exact where it is small
+ * The ranges of exp and log are reduced with Cody and Waite's split of ln 2: ln2_hi has 15
+ * significant bits, so n ln2_hi is exact for |n| < 512 and x - n ln2_hi exact where it is small
  * (Sterbenz); ln2_lo = ln 2 - ln2_hi. */
 #ifndef WP_ELEMENTARY_H
 #define WP_ELEMENTARY_H
@@ -91,6 +96,48 @@ static inline float powr_poly(float x, float c) {
 /* The cube root of x >= 0. */
 static inline float cbrt_poly(float x) {
   return exp_poly(log_poly(x) * (1.0f / 3.0f));
+}
+
+/* log2 x, as log_poly(x) / ln 2: within 5 u of ln x's value over ln 2. */
+static inline float log2_poly(float x) {
+  return log_poly(x) * 1.44269504f;
+}
+
+/* (cos t, sin t) for |t| <= pi/4, by their Taylor polynomials to t^10 and t^9: the remainders are
+ * below (pi/4)^12 / 12! = 1.1e-10 and (pi/4)^11 / 11! = 1.8e-9, far under float's rounding, so
+ * the result is as good as cos() and sin(), at a fraction of their cost on PoCL (about 13 ns per
+ * pair there, with their argument reduction). */
+static inline float2 cos_sin_quarter(float t) {
+  const float t2 = t * t;
+  const float c =
+      1.0f +
+      t2 * (-0.5f + t2 * (1.0f / 24.0f + t2 * (-1.0f / 720.0f +
+                                               t2 * (1.0f / 40320.0f - t2 * (1.0f / 3628800.0f)))));
+  const float s =
+      t * (1.0f + t2 * (-1.0f / 6.0f +
+                        t2 * (1.0f / 120.0f + t2 * (-1.0f / 5040.0f + t2 * (1.0f / 362880.0f)))));
+  return (float2)(c, s);
+}
+
+/* (cos, sin) of the angle 2 pi u for u in [0, 1]: the nearest quarter turn q and the rest t,
+ * |t| <= pi/4 (x - q is exact), by cos_sin_quarter, rotated by q quarter turns. No call to the
+ * library's cos and sin, whose argument reduction PoCL keeps out of line. */
+static inline float2 cos_sin_turn(float u) {
+  const float x = 4.0f * u;
+  const float q = floor(x + 0.5f);
+  const float2 cs = cos_sin_quarter((x - q) * (0.5f * WP_PI));
+  const int k = (int)q & 3;
+  const float c = k == 0 ? cs.x : k == 1 ? -cs.y : k == 2 ? -cs.x : cs.y;
+  const float s = k == 0 ? cs.y : k == 1 ? cs.x : k == 2 ? -cs.y : -cs.x;
+  return (float2)(c, s);
+}
+
+/* cos x for finite x: x in turns less its whole turns (exact), then cos_sin_turn. The turns are off
+ * by 2 u of themselves (the float 1 / (2 pi) and the product), 2 u |x| in the angle, so the error
+ * grows with |x|: within 4e-7 + 1.2e-7 |x|. */
+static inline float cos_poly(float x) {
+  const float t = x * (0.5f * WP_INV_PI);
+  return cos_sin_turn(t - floor(t)).x;
 }
 
 /* atan2(y, x) in [-pi, pi] (an environment map's lookup at every escaped ray took 12% of a render

@@ -55,6 +55,7 @@
 #define WP_IRIDESCENCE_H
 
 #include "common.h"
+#include "elementary.h"
 
 /* A film thinner than this fades into the bare base (smoothstep from 0 nm, no film, to here): its
  * optical path 2 n2 d is then at most 40 nm for n2 <= 2, a tenth of the shortest visible
@@ -71,10 +72,13 @@
  * caller applies. */
 static inline float3 iridescence_sensitivity(float opd) {
   const float o2 = opd * opd;
+  const float3 k = (float3)(0.0105620345f, 0.0112802026f, 0.0138757864f) * opd;
+  const float3 g = -(float3)(1.70854696e-7f, 3.67330884e-7f, 2.61035245e-7f) * o2;
   const float3 xyz = (float3)(0.846590002f, 1.00022189f, 1.00112249f) *
-                     cos((float3)(0.0105620345f, 0.0112802026f, 0.0138757864f) * opd) *
-                     exp(-(float3)(1.70854696e-7f, 3.67330884e-7f, 2.61035245e-7f) * o2);
-  const float x = xyz.x + 0.153868307f * cos(0.0140737068f * opd) * exp(-1.78766171e-7f * o2);
+                     (float3)(cos_poly(k.x), cos_poly(k.y), cos_poly(k.z)) *
+                     (float3)(exp_poly(g.x), exp_poly(g.y), exp_poly(g.z));
+  const float x =
+      xyz.x + 0.153868307f * cos_poly(0.0140737068f * opd) * exp_poly(-1.78766171e-7f * o2);
   return (float3)(2.68835092f * x - 1.27524336f * xyz.y - 0.413592437f * xyz.z,
                   -1.02208802f * x + 1.97824763f * xyz.y + 0.0438206745f * xyz.z,
                   0.061145945f * x - 0.224201908f * xyz.y + 1.16177361f * xyz.z);

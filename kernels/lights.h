@@ -52,7 +52,8 @@ static inline uint pick_light(const SceneView* scene, float u, float* pmf, float
 /* KHR_lights_punctual's recommended range window, applied only when a range is given. */
 static inline float range_window(float dist, float range) {
   if (range <= 0.0f) return 1.0f;
-  return clamp(1.0f - pow(dist / range, 4.0f), 0.0f, 1.0f);
+  const float q = dist / range, q2 = q * q;
+  return clamp(1.0f - q2 * q2, 0.0f, 1.0f);
 }
 
 static inline LightSample sample_punctual(__global const Light* light, float3 p) {

@@ -39,6 +39,7 @@
 #ifndef WP_RAY_CONE_H
 #define WP_RAY_CONE_H
 
+#include "elementary.h"
 #include "path_state.h"
 
 #if WP_FEATURE_TEXTURE_LOD
@@ -103,8 +104,9 @@ static inline float2 footprint_lod(float width, float cos_theta, float twice_are
                                    float4 uv1, float4 uv2) {
   const float4 a = uv1 - uv0, b = uv2 - uv0;
   const float2 uv_area = fabs((float2)(a.x * b.y - a.y * b.x, a.z * b.w - a.w * b.z));
-  const float base = log2(fabs(width) / fmax(fabs(cos_theta), 1e-6f)) - 0.5f * log2(twice_area);
-  return base + 0.5f * log2(uv_area);
+  const float base =
+      log2_poly(fabs(width) / fmax(fabs(cos_theta), 1e-6f)) - 0.5f * log2_poly(twice_area);
+  return base + 0.5f * (float2)(log2_poly(uv_area.x), log2_poly(uv_area.y));
 }
 #endif
 

@@ -6,35 +6,6 @@
 #include "common.h"
 #include "elementary.h"
 
-/* (cos t, sin t) for |t| <= pi/4, by their Taylor polynomials to t^10 and t^9: the remainders are
- * below (pi/4)^12 / 12! = 1.1e-10 and (pi/4)^11 / 11! = 1.8e-9, far under float's rounding, so
- * the result is as good as cos() and sin(), at a fraction of their cost on PoCL (about 13 ns per
- * pair there, with their argument reduction). */
-static inline float2 cos_sin_quarter(float t) {
-  const float t2 = t * t;
-  const float c =
-      1.0f +
-      t2 * (-0.5f + t2 * (1.0f / 24.0f + t2 * (-1.0f / 720.0f +
-                                               t2 * (1.0f / 40320.0f - t2 * (1.0f / 3628800.0f)))));
-  const float s =
-      t * (1.0f + t2 * (-1.0f / 6.0f +
-                        t2 * (1.0f / 120.0f + t2 * (-1.0f / 5040.0f + t2 * (1.0f / 362880.0f)))));
-  return (float2)(c, s);
-}
-
-/* (cos, sin) of the angle 2 pi u for u in [0, 1]: the nearest quarter turn q and the rest t,
- * |t| <= pi/4 (x - q is exact), by cos_sin_quarter, rotated by q quarter turns. No call to the
- * library's cos and sin, whose argument reduction PoCL keeps out of line. */
-static inline float2 cos_sin_turn(float u) {
-  const float x = 4.0f * u;
-  const float q = floor(x + 0.5f);
-  const float2 cs = cos_sin_quarter((x - q) * (0.5f * WP_PI));
-  const int k = (int)q & 3;
-  const float c = k == 0 ? cs.x : k == 1 ? -cs.y : k == 2 ? -cs.x : cs.y;
-  const float s = k == 0 ? cs.y : k == 1 ? cs.x : k == 2 ? -cs.y : -cs.x;
-  return (float2)(c, s);
-}
-
 /* Uniform on the unit disk (Shirley and Chiu's concentric mapping of the square, area-preserving):
  * pdf = 1 / pi. The disk angle is (pi/4) q or pi/2 - (pi/4) q with |q| <= 1, so cos_sin_quarter
  * serves both. */

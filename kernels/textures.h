@@ -21,11 +21,6 @@
 #include "scene.h"
 #include "srgb_lut.h"
 
-/* The sRGB EOTF (IEC 61966-2-1): encoded value c in [0, 1] to linear. */
-static inline float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
-}
-
 /* Texel (x, y) of `img` (both in range) as RGBA in [0, 1], decoded to linear when srgb. */
 static inline float4 texel_fetch(__global const uint* texels, TextureImage img, int x, int y,
                                  bool srgb) {
@@ -33,7 +28,7 @@ static inline float4 texel_fetch(__global const uint* texels, TextureImage img, 
   float4 c = (float4)((float)(p & 0xffu), (float)((p >> 8) & 0xffu), (float)((p >> 16) & 0xffu),
                       (float)(p >> 24)) *
              (1.0f / 255.0f);
-  if (srgb) /* the table holds srgb_to_linear of every code */
+  if (srgb) /* the table holds the sRGB EOTF of every code (srgb_lut.h) */
     c.xyz = (float3)(wp_srgb_lut[p & 0xffu], wp_srgb_lut[(p >> 8) & 0xffu],
                      wp_srgb_lut[(p >> 16) & 0xffu]);
   return c;

@@ -78,6 +78,51 @@ TEST(KernelSources, PathStateIsReachedOnlyThroughItsAccessors) {
   EXPECT_GT(files, 20);
 }
 
+// The kernels' source with its comments blanked (newlines kept, so line numbers stay).
+std::string without_comments(const std::string& text) {
+  std::string out = text;
+  for (std::size_t i = 0; i + 1 < out.size(); ++i) {
+    if (out[i] == '/' && out[i + 1] == '*') {
+      const std::size_t end = out.find("*/", i + 2);
+      const std::size_t stop = end == std::string::npos ? out.size() : end + 2;
+      for (std::size_t k = i; k < stop; ++k)
+        if (out[k] != '\n') out[k] = ' ';
+      i = stop - 1;
+    } else if (out[i] == '/' && out[i + 1] == '/') {
+      for (; i < out.size() && out[i] != '\n'; ++i) out[i] = ' ';
+    }
+  }
+  return out;
+}
+
+// No kernel calls OpenCL's transcendental builtins: PoCL compiles them into out-of-line library
+// routines, which took 12-20% of renders where they were on the hot path (docs/performance.md,
+// "Environment lookups without library calls", "Sheen without library calls");
+// kernels/elementary.h has inlined versions with stated bounds. sqrt, fma, floor and the like,
+// single instructions, are not in the list.
+TEST(KernelSources, NoTranscendentalLibraryCalls) {
+  const std::regex call(
+      R"((^|[^\w.])(exp|exp2|exp10|expm1|log|log2|log10|log1p|logb|pow|powr|pown|rootn|cbrt|sin|)"
+      R"(cos|tan|sincos|sinpi|cospi|tanpi|asin|acos|atan|atan2|atanpi|atan2pi|sinh|cosh|tanh|)"
+      R"(asinh|acosh|atanh|hypot|erf|erfc|tgamma|lgamma)\s*\()");
+  // The pattern catches what it is meant to (else the test below could pass by matching nothing).
+  EXPECT_TRUE(std::regex_search(std::string("x = pow(a, 2.4f);"), call));
+  EXPECT_TRUE(std::regex_search(std::string("  return exp (y) * 2;"), call));
+  EXPECT_FALSE(std::regex_search(std::string("exp_poly(x) + s.log(x) + sqrt(y) + x.cos"), call));
+  EXPECT_FALSE(std::regex_search(without_comments("/* pow(x) */ a; // cos(y)\n"), call));
+  int files = 0;
+  for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
+    ++files;
+    std::istringstream lines(without_comments(f.text));
+    int number = 0;
+    for (std::string line; std::getline(lines, line);) {
+      ++number;
+      EXPECT_FALSE(std::regex_search(line, call)) << f.name << ":" << number << ": " << line;
+    }
+  }
+  EXPECT_GT(files, 20);
+}
+
 // Every stage has its entry point, and every stage but the fused one its logic header; the fused
 // shade includes the four headers of the stages it fuses.
 TEST(KernelSources, EveryStageHasItsFiles) {

@@ -754,6 +754,32 @@ TEST_F(Elementary, PowrAndCbrt) {
   EXPECT_EQ(run(4, {{{0.0f, 0}}, {{1.0f, 0}}, {{8.0f, 0}}})[0], 0.0f);
 }
 
+// log2_poly = log_poly / ln 2: log's 4 u (3.1 u where the result is smallest, near 1, as
+// Elementary.Log derives) and the product's u: within 5 u. cos_poly: the turns x / (2 pi) off by
+// 2 u of themselves (the float constant and the product; the whole turns come off exactly), 2 u
+// |x| in the angle, and cos_sin_turn's 4e-7 (Sampling.CosSinTurn): within 4e-7 + 1.2e-7 |x|, over
+// |x| <= 200 (iridescence's arguments grow with the film's optical path, but past a few hundred
+// radians the Gaussian factor that multiplies the cosine there is below 1e-7).
+TEST_F(Elementary, Log2AndCos) {
+  const std::vector<cl_float2> in = random_bits(1e-45f, 3.4e38f, 1 << 20, 17);
+  EXPECT_LE(worst_u(
+                5, in, [](double x) { return std::log2(x); }, "log2_poly"),
+            5.0);
+  std::vector<cl_float2> angles;
+  constexpr int kN = 1 << 20;
+  for (int i = 0; i < kN; ++i)
+    angles.push_back({{-200.0f + 400.0f * (static_cast<float>(i) + 0.5f) / kN, 0.0f}});
+  const std::vector<float> v = run(6, angles);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < angles.size(); ++i) {
+    const double x = angles[i].s[0];
+    worst = std::max(worst, std::fabs(v[i] - std::cos(x)) / (4e-7 + 1.2e-7 * std::fabs(x)));
+  }
+  std::cout << "  cos_poly: largest error " << worst << " of the bound\n";
+  EXPECT_LE(worst, 1.0);
+  EXPECT_EQ(run(6, {{{0.0f, 0}}})[0], 1.0f);
+}
+
 // The thin lens's disc sampler (kernels/camera.h): uniform on the unit disc, pdf 1/pi. Binned into
 // 16 rings of equal area (r^2 in steps of 1/16) x 32 sectors, each of probability 1/512, from 2^20
 // independent points of the square (a host Mersenne Twister, so the counts are multinomial and

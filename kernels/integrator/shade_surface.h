@@ -7,6 +7,7 @@
 #define WP_INTEGRATOR_SHADE_SURFACE_H
 
 #include "stage.h"
+#include "elementary.h"
 #include "lights.h"
 #include "mis.h"
 #include "surface.h"
@@ -81,7 +82,8 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
    * transmittance attenuationColor^(distance / attenuationDistance) (KHR_materials_volume). */
   const float4 vol = scene->materials[tv.w].volume;
   if (!front && (s->flags & WP_SURF_VOLUME) && vol.w < INFINITY) {
-    beta *= pow(vol.xyz, t / vol.w);
+    const float e = t / vol.w; /* > 0: t > 0, attenuationDistance finite */
+    beta *= (float3)(powr_poly(vol.x, e), powr_poly(vol.y, e), powr_poly(vol.z, e));
     path_set_throughput(paths, slot, beta);
   }
 #endif

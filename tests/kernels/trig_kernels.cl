@@ -20,7 +20,8 @@ __kernel void atan2_poly_at(__global const float2* yx, uint count, __global floa
 }
 
 /* out[i] = the elementary function `fn` of kernels/elementary.h at in[i] (0: exp_poly of x, 1:
- * log_poly of x, 2: log1p_poly of x, 3: powr_poly(x, y), 4: cbrt_poly of x), (x, y) = in[i]. */
+ * log_poly of x, 2: log1p_poly of x, 3: powr_poly(x, y), 4: cbrt_poly of x, 5: log2_poly of x, 6:
+ * cos_poly of x), (x, y) = in[i]. */
 __kernel void elementary_at(__global const float2* in, uint count, uint fn, __global float* out) {
   const uint i = get_global_id(0);
   if (i >= count) return;
@@ -29,5 +30,7 @@ __kernel void elementary_at(__global const float2* in, uint count, uint fn, __gl
            : fn == 1u ? log_poly(x)
            : fn == 2u ? log1p_poly(x)
            : fn == 3u ? powr_poly(x, y)
-                      : cbrt_poly(x);
+           : fn == 4u ? cbrt_poly(x)
+           : fn == 5u ? log2_poly(x)
+                      : cos_poly(x);
 }
