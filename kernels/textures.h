@@ -99,9 +99,13 @@ static inline TexLookup texture_lookup(const SceneView* scene, int ref, float4 u
 }
 
 /* Lookup l at level `img` (the image or one of its mip levels), bilinear, or NEAREST with
- * `nearest`. */
-static inline float4 texel_filtered(__global const uint* texels, TexLookup l, TextureImage img,
-                                    bool nearest) {
+ * `nearest`. Always inlined, as texture_at is: clang kept both out of line in the shading kernel,
+ * where a model's lookups (base colour, metal-roughness, normal, emission) then ran one call after
+ * another, each waiting on its texels; inlined, their loads overlap (DamagedHelmet 1.12x the
+ * samples/s on PoCL, docs/performance.md, "Texture lookups inlined"). */
+static inline __attribute__((always_inline)) float4 texel_filtered(__global const uint* texels,
+                                                                   TexLookup l, TextureImage img,
+                                                                   bool nearest) {
   const uint wrap_s = l.meta_y & 0xffu, wrap_t = (l.meta_y >> 8) & 0xffu;
   const bool srgb = (l.meta_y & WP_TEX_SRGB) != 0u;
   const int w = (int)img.width, h = (int)img.height;
@@ -164,7 +168,8 @@ static inline float4 texture_sample_lod(const SceneView* scene, int ref, float4 
 
 /* Texture `ref` at point tp: through its ray cone with WP_FEATURE_TEXTURE_LOD, else at full
  * resolution. */
-static inline float4 texture_at(const SceneView* scene, int ref, TexPoint tp) {
+static inline __attribute__((always_inline)) float4 texture_at(const SceneView* scene, int ref,
+                                                               TexPoint tp) {
 #if WP_FEATURE_TEXTURE_LOD
   return texture_sample_lod(scene, ref, tp.uv, tp.lod);
 #else
