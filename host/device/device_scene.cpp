@@ -15,6 +15,7 @@
 
 #include "host/scene/mipmap.h"
 #include "host/util/error.h"
+#include "host/util/parallel.h"
 
 namespace wp {
 
@@ -155,17 +156,31 @@ int packed_levels(const Image& img, const ImageUses& uses, std::size_t i) {
 
 // All images' texels in one array, RGBA8 with R in the lowest byte; with `mipmaps`, each image
 // that image_uses chains is followed by its chain, filtered as colour when a texture uses it as
-// colour (sRGB), else as data.
+// colour (sRGB), else as data. The chains of a batch of images (one per hardware thread) are made
+// at once, each on a thread of its own, so that no more than a batch of them is held beside the
+// packed texels; the packing keeps the images' order.
 void pack_images(const Scene& scene, bool mipmaps, std::vector<dev::TextureImage>& images,
                  std::vector<dev::uint>& texels) {
   const ImageUses uses = image_uses(scene, mipmaps);
-  for (std::size_t i = 0; i < scene.images.size(); ++i) {
-    const Image& img = scene.images[i];
-    const int levels = packed_levels(img, uses, i);
-    images.push_back({static_cast<dev::uint>(texels.size()), static_cast<dev::uint>(img.width),
-                      static_cast<dev::uint>(img.height), static_cast<dev::uint>(levels)});
-    pack_rgba8(img.rgba, texels);
-    if (levels > 1) pack_rgba8(mip_chain(img, uses.colour[i] != 0), texels);
+  const std::size_t count = scene.images.size(), batch = host_threads();
+  std::vector<std::vector<std::uint8_t>> chains(batch);
+  for (std::size_t first = 0; first < count; first += batch) {
+    const std::size_t n = std::min(batch, count - first);
+    parallel_for(n, [&](std::size_t k) {
+      const std::size_t i = first + k;
+      if (packed_levels(scene.images[i], uses, i) > 1)
+        chains[k] = mip_chain(scene.images[i], uses.colour[i] != 0);
+    });
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = first + k;
+      const Image& img = scene.images[i];
+      const int levels = packed_levels(img, uses, i);
+      images.push_back({static_cast<dev::uint>(texels.size()), static_cast<dev::uint>(img.width),
+                        static_cast<dev::uint>(img.height), static_cast<dev::uint>(levels)});
+      pack_rgba8(img.rgba, texels);
+      if (levels > 1) pack_rgba8(chains[k], texels);
+      std::vector<std::uint8_t>().swap(chains[k]);  // freed before the next batch
+    }
   }
 }
 
