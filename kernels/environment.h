@@ -16,7 +16,7 @@
  *     (x = -1 is W - 1, x = W is 0). Rows clamp at the poles (y = -1 is 0, y = H is H - 1): within
  *     half a texel of a pole the map is interpolated along u only, so the pole value depends on
  *     the direction of approach as it does with nearest lookup (the pole is a null set).
- * The two atan2 are atan2_poly's (sampling.h), which PoCL inlines.
+ * The two atan2 are atan2_poly's (elementary.h), which PoCL inlines.
  *
  * Sampling tables (host/lights/environment.cpp fills them), float CDFs, built for the filter:
  *   env_marginal[0..H]: over rows; [0] = 0, [H] = 1, row y has probability

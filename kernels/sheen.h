@@ -44,8 +44,9 @@
  * (1 + Lambda_o + Lambda_i) underflows, for (n.wo)(n.wi) below ~1e-47; sheen_eval then returns
  * FLT_MAX, not inf (the true value is beyond float32 there). Where |wo + wi|^2 underflows (both
  * within 1e-19 of the horizon and opposite) h has no float32 direction and sheen_eval returns 0.
- * exp, log, log1p, pow and cbrt are elementary.h's inlined polynomials, within OpenCL's bounds for
- * the library's (PoCL's out-of-line calls took 19.5% of a render of SheenChair).
+ * exp, log, log1p, pow and cbrt are elementary.h's inlined polynomials, each with its stated bound,
+ * which tests/test_sheen.cpp's error model takes (PoCL's out-of-line library calls took 19.5% of a
+ * render of SheenChair).
  *
  * WP_SHEEN_ROUGHNESS_MIN = 0.07 (alpha 0.0049). Below it E keeps growing, like ~0.2 / roughness
  * (6.4 at roughness 0.03, 18 at 0.01), with features of width ~roughness in mu, too fine for the
