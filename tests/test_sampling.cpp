@@ -540,7 +540,8 @@ TEST(Sampling, CosSinTurn) {
 // precision atan2 of the same floats, at 2^20 angles around the circle (each at radii from 1e-30
 // to 1e30, where the quotient min/max must not lose its precision), densely near the octant
 // boundaries |x| = |y| where the reflection pi/2 - r takes over, and on the axes with both signed
-// zeros. The bound, summed over the steps: the quotient a = min/max rounds by at most 2^-24 a
+// zeros. The bound, summed over the steps: the quotient a = min/max, correctly rounded on PoCL
+// (Elementary's comment below says more), rounds by at most 2^-24 a
 // (6e-8 in the angle, as atan' <= 1); the polynomial with float coefficients, evaluated by Horner
 // in float, is within 1.1e-7 of atan on [0, 1] (tools/gen_atan_poly.py, at 4 million points);
 // pi/2 - r and pi - r round by at most half an ulp of results below 2 and 4 (6e-8, 1.2e-7) with
