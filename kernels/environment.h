@@ -72,15 +72,20 @@ static inline float env_texel_pdf(float p, uint w, uint h, float sin_theta) {
   return sin_theta > 0.0f ? p * ((float)w * (float)h) / (2.0f * WP_PI * WP_PI * sin_theta) : 0.0f;
 }
 
+/* The map coordinates (u, v) of map-frame direction m (any length), with r_xz = |m.xz|; theta by
+ * atan2, well conditioned at the poles, unlike acos. */
+static inline float2 env_map_uv(float3 m, float r_xz) {
+  return (float2)(fmax(0.0f, atan2_poly(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI),
+                  atan2_poly(r_xz, m.y) * WP_INV_PI);
+}
+
 /* Texel (x, y) seen along map-frame direction m (any length); *sin_theta gets its sin(theta). */
 static inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
   const float r_xz = sqrt(m.x * m.x + m.z * m.z);
-  const float u = fmax(0.0f, atan2_poly(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
-  /* theta by atan2: well conditioned at the poles, unlike acos */
-  const float v = atan2_poly(r_xz, m.y) * WP_INV_PI;
+  const float2 uv = env_map_uv(m, r_xz);
   *sin_theta = r_xz / length(m);
-  return (uint2)(min((uint)(u * (float)d->env_width), d->env_width - 1u),
-                 min((uint)(v * (float)d->env_height), d->env_height - 1u));
+  return (uint2)(min((uint)(uv.x * (float)d->env_width), d->env_width - 1u),
+                 min((uint)(uv.y * (float)d->env_height), d->env_height - 1u));
 }
 
 /* The interval of CDF cdf[0..n] holding u: the largest i < n with cdf[i] <= u. When
@@ -119,9 +124,8 @@ static inline float3 env_bilinear(const SceneView* scene, float u, float v) {
 static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
   const SceneDesc* d = scene->desc;
   const float3 m = env_to_map(d, dir);
-  const float u = fmax(0.0f, atan2_poly(m.x, -m.z) + WP_PI) * (0.5f * WP_INV_PI);
-  const float v = atan2_poly(sqrt(m.x * m.x + m.z * m.z), m.y) * WP_INV_PI;
-  return env_bilinear(scene, u, v) * d->env_params.x;
+  const float2 uv = env_map_uv(m, sqrt(m.x * m.x + m.z * m.z));
+  return env_bilinear(scene, uv.x, uv.y) * d->env_params.x;
 }
 #else
 static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {

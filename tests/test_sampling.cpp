@@ -755,7 +755,7 @@ TEST_F(Elementary, PowrAndCbrt) {
   EXPECT_LE(worst, 1.0);
   const std::vector<float> zero = run(3, {{{0.0f, 0.2f}}});
   EXPECT_EQ(zero[0], 0.0f);
-  EXPECT_EQ(run(4, {{{0.0f, 0}}, {{1.0f, 0}}, {{8.0f, 0}}})[0], 0.0f);
+  EXPECT_EQ(run(4, {{{0.0f, 0}}})[0], 0.0f);
 }
 
 // log2_poly = log_poly / ln 2: log's 4 u (3.1 u where the result is smallest, near 1, as
