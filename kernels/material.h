@@ -218,10 +218,10 @@ static inline void resolve_extensions(const SceneView* scene, __global const Mat
 #endif
 
 /* The texture coordinates at barycentrics (u, v) of triangle tv and, with WP_FEATURE_TEXTURE_LOD,
- * the footprint there of a ray cone `cone_width` across arriving at cos_theta to the triangle's
- * plane (twice_area: |cross(p1 - p0, p2 - p0)|; ray_cone.h). */
+ * the footprint there of a ray cone `cone_width` across (twice_area: |cross(p1 - p0, p2 - p0)|;
+ * ray_cone.h). */
 static inline TexPoint texture_point(const SceneView* scene, uint4 tv, float u, float v,
-                                     float cone_width, float cos_theta, float twice_area) {
+                                     float cone_width, float twice_area) {
   TexPoint tp;
 #if WP_FEATURE_TEXTURES || WP_FEATURE_NORMAL_MAPS || WP_BSDF_EXTENSIONS
   tp.uv = interpolate4(scene->uvs, tv, u, v);
@@ -230,10 +230,10 @@ static inline TexPoint texture_point(const SceneView* scene, uint4 tv, float u, 
   tp.uv = (float4)(0.0f);
 #endif
 #if WP_FEATURE_TEXTURE_LOD
-  tp.lod = footprint_lod(cone_width, cos_theta, twice_area, scene->uvs[tv.x], scene->uvs[tv.y],
-                         scene->uvs[tv.z]);
+  tp.lod =
+      footprint_lod(cone_width, twice_area, scene->uvs[tv.x], scene->uvs[tv.y], scene->uvs[tv.z]);
 #else
-  (void)cone_width, (void)cos_theta, (void)twice_area;
+  (void)cone_width, (void)twice_area;
 #endif
   return tp;
 }
@@ -257,7 +257,7 @@ static inline Surface resolve_surface(const SceneView* scene, uint inst, uint tr
   s.ng = len > 0.0f ? n / len : -ray_d; /* a degenerate triangle faces the ray */
   *front = dot(s.ng, ray_d) < 0.0f;
   if (!*front) s.ng = -s.ng;
-  const TexPoint tp = texture_point(scene, tv, u, v, cone_width, dot(s.ng, ray_d), len);
+  const TexPoint tp = texture_point(scene, tv, u, v, cone_width, len);
 #if WP_FEATURE_TEXTURE_LOD
   s.curvature =
       triangle_curvature(p0, p1, p2, placed_normal(scene, inst, tv.x),

@@ -10,13 +10,21 @@
  *   camera      a pinhole starts with w = 0 and g = an eighth of the pixel's angle,
  *               2 tan(yfov / 2) / height; an orthographic camera with w = an eighth of the pixel's
  *               height, 2 ymag / height, and g = 0. A thin lens keeps the pinhole's cone.
- *   hit at t    w' = w + g t; the cone's footprint on the surface is |w'| / |cos| across, cos the
- *               angle between the ray and the geometric normal.
- *   level       lambda = log2(|w'| / |cos|) + 1/2 log2(A_uv / A_world) + 1/2 log2(W H |det T|):
- *               the footprint's side in texels of a W x H texture whose coordinates (transformed
- *               by KHR_texture_transform's T) cover A_uv where the triangle covers A_world;
- *               textures.h samples trilinearly at lambda (level 0 where lambda <= 0, as without
- *               mip-maps).
+ *   hit at t    w' = w + g t; the cone's footprint on the surface is an ellipse |w'| across
+ *               and |w'| / |cos| along the ray's direction, cos the angle between the ray and
+ *               the geometric normal.
+ *   level       lambda = log2 |w'| + 1/2 log2(A_uv / A_world) + 1/2 log2(W H |det T|): the
+ *               footprint's minor axis in texels of a W x H texture whose coordinates
+ *               (transformed by KHR_texture_transform's T) cover A_uv where the triangle covers
+ *               A_world; textures.h samples trilinearly at lambda (level 0 where lambda <= 0, as
+ *               without mip-maps). The minor axis, not the major one: a trilinear lookup filters
+ *               both directions alike, and at the major axis's level it would average across the
+ *               ray by 1 / |cos| more than the footprint (at grazing angles whole stripes of a
+ *               texture, and normal and roughness maps into other highlights, whatever the
+ *               number of samples). At the minor axis's level it averages within the footprint
+ *               everywhere; along the ray the pixel's samples, spread over the pixel, average
+ *               what the lookup leaves. Measured in docs/performance.md, "Mip-mapped textures:
+ *               error against time" (grazing angles).
  *   scattering  g' = g + 2 k w' for the surface's curvature k (below): a mirror on a sphere of
  *               radius R (k = 1/R) bends the rays across a footprint w' by 2 w'/R; plus, for a
  *               sample of a lobe that is not delta, an eighth of min(2 / sqrt(pi pdf), pi), the
@@ -29,10 +37,11 @@
  * Why an eighth: the samples of a pixel are already spread over it (box filter) and each scattered
  * sample's neighbours over its lobe, so a cone as wide as a whole footprint blurs the image twice
  * over. Measured on DamagedHelmet seen small (tools/mip_study.py's case, 256 x 256, the model ~50
- * pixels across, 1024 spp): the mip-mapped image converges to a relMSE of 0.0064 from the
- * unfiltered one with whole footprints, 4.7e-4 with a quarter, 1.9e-4 with an eighth (pbrt-v4's
- * smallest scale of its ray differentials too), while its relMSE at equal samples stays 1.3-1.6x
- * below the unfiltered render's (docs/performance.md, "Mip-mapped textures: error against time").
+ * pixels across, 1024 spp): the mip-mapped image converges to a relMSE of 9.3e-5 from the
+ * unfiltered one with an eighth (pbrt-v4's smallest scale of its ray differentials too), 2.4e-4
+ * with a quarter (0.0064 with whole footprints, measured with the major axis's level), while its
+ * relMSE at equal samples stays 1.2-1.75x below the unfiltered render's (docs/performance.md,
+ * "Mip-mapped textures: error against time").
  * Emission and alpha are always looked up at level 0 (material_emission, alpha.h), so that the
  * light tables, light samples and shadow rays, which carry no cone, see the same values as the
  * paths. */
@@ -98,14 +107,14 @@ static inline float lobe_spread(float pdf) {
 
 /* log2 of the cone's footprint at a hit, per texture coordinate set (x: TEXCOORD_0, y:
  * TEXCOORD_1), without the texture's own term (its 1/2 log2(W H |det T|), TextureRef.meta.w):
- * log2(|width| / |cos|) + 1/2 log2(A_uv / A_world). twice_area is |cross(p1 - p0, p2 - p0)|, the
- * uv's are the three vertices' (xy set 0, zw set 1). -INFINITY (level 0) for a zero width. */
-static inline float2 footprint_lod(float width, float cos_theta, float twice_area, float4 uv0,
-                                   float4 uv1, float4 uv2) {
+ * log2 |width| + 1/2 log2(A_uv / A_world), the footprint's minor axis (the file comment says why
+ * not its major one). twice_area is |cross(p1 - p0, p2 - p0)|, the uv's are the three vertices'
+ * (xy set 0, zw set 1). -INFINITY (level 0) for a zero width. */
+static inline float2 footprint_lod(float width, float twice_area, float4 uv0, float4 uv1,
+                                   float4 uv2) {
   const float4 a = uv1 - uv0, b = uv2 - uv0;
   const float2 uv_area = fabs((float2)(a.x * b.y - a.y * b.x, a.z * b.w - a.w * b.z));
-  const float base =
-      log2_poly(fabs(width) / fmax(fabs(cos_theta), 1e-6f)) - 0.5f * log2_poly(twice_area);
+  const float base = log2_poly(fabs(width)) - 0.5f * log2_poly(twice_area);
   return base + 0.5f * (float2)(log2_poly(uv_area.x), log2_poly(uv_area.y));
 }
 #endif

@@ -366,16 +366,15 @@ TEST_F(RenderKnown, EmptySceneShowsOnlyTheBackground) {
   }
 }
 
-// A 2 x 2 square in the plane z = 0 facing +z, textured with a 64 x 64 checkerboard of black and
-// white texels (sRGB colour, magnification NEAREST, REPEAT) repeated 32 times across: 1024
-// texels per unit. Unlit (the image is the texture itself) or Lambertian.
-wp::Scene checker_scene(bool unlit) {
-  wp::Scene s;
+// Adds a 64 x 64 texture of black and white texels (sRGB colour, magnification NEAREST, REPEAT),
+// white where white(column, row) holds, as the scene's texture 0.
+template <typename White>
+void add_black_and_white_texture(wp::Scene& s, White white) {
   wp::Image img;
   img.width = img.height = 64;
   for (int j = 0; j < 64; ++j)
     for (int i = 0; i < 64; ++i) {
-      const std::uint8_t v = (i + j) % 2 ? 255 : 0;
+      const std::uint8_t v = white(i, j) ? 255 : 0;
       img.rgba.insert(img.rgba.end(), {v, v, v, 255});
     }
   s.images.push_back(img);
@@ -384,6 +383,14 @@ wp::Scene checker_scene(bool unlit) {
   t.srgb = true;
   t.nearest = true;
   s.textures.push_back(t);
+}
+
+// A 2 x 2 square in the plane z = 0 facing +z, textured with a 64 x 64 checkerboard of black and
+// white texels (sRGB colour, magnification NEAREST, REPEAT) repeated 32 times across: 1024
+// texels per unit. Unlit (the image is the texture itself) or Lambertian.
+wp::Scene checker_scene(bool unlit) {
+  wp::Scene s;
+  add_black_and_white_texture(s, [](int i, int j) { return (i + j) % 2 != 0; });
   wp::Material m = wp::test::diffuse_material(vec3(1.0f));
   m.unlit = unlit;
   m.specular = 0.0f;  // Lambert's BSDF alone: under a white sky its radiance is its albedo
@@ -475,6 +482,51 @@ TEST_F(RenderKnown, NearCheckerboardStaysSharpWithMipmaps) {
   const auto [lo, hi] = std::minmax_element(on.image.rgb.begin(), on.image.rgb.end());
   EXPECT_EQ(*lo, 0.0f);
   EXPECT_EQ(*hi, 1.0f);
+}
+
+// A floor seen at grazing angles keeps what runs along the view: stripes of white and black
+// texels, constant along z, on an unlit floor (x in [-1, 1], z in [-8, 0], y = 0) under a white
+// background, seen from 0.05 above it toward (0, 0, -5) through a 0.5 rad field of view, 48 x 48.
+// The floor's texture coordinates run 2 periods of a 64-texel image per unit both ways (128 texels
+// per unit, sRGB, NEAREST): columns 0-31 white, 32-63 black, u = 2x + 1/4, so the white stripe
+// |x| < 1/8 lies under the image's two middle columns at every distance (a pixel is 0.0106 rad,
+// 0.085 units wide at the floor's far edge). Every sample of those columns sees white, the
+// floor's or the background's: each pixel is 1 (float rounding of the trilinear weights, 1e-6),
+// with or without mip-maps. The rows near the horizon meet the floor at cos 0.01-0.04, where a cone
+// an eighth of a pixel is 0.1-0.9 texel across (level 0-0.4) but 10-85 texels along the view; a
+// level taken from that length (the isotropic footprint width / cos, wavepath's until 2026-11-27)
+// averages whole periods there and renders those pixels 0.5-0.9.
+TEST_F(RenderKnown, GrazingStripesKeepTheirContrastWithMipmaps) {
+  wp::Scene s;
+  add_black_and_white_texture(s, [](int i, int) { return i < 32; });
+  wp::Material m = wp::test::diffuse_material(vec3(1.0f));
+  m.unlit = true;
+  m.base_color_texture = 0;
+  s.materials.push_back(m);
+  wp::test::add_quad(s, {-1, 0, 0}, {1, 0, 0}, {1, 0, -8}, {-1, 0, -8}, 0);
+  for (std::size_t v = 0; v < 4; ++v)
+    s.uv0[v] = glm::vec2(2.0f * s.positions[v].x + 0.25f, -2.0f * s.positions[v].z);
+  wp::test::finish_bounds(s);
+  s.cameras = {wp::test::look_at({0.0f, 0.05f, 0.0f}, {0.0f, 0.0f, -5.0f}, 0.5f)};
+  wp::RenderSettings st;
+  st.width = st.height = 48;
+  st.spp = 4;
+  st.camera = 0;
+  st.background = vec3(1.0f);
+  st.sampler = wp::Sampler::kIndependent;
+  for (const bool mipmaps : {true, false}) {
+    SCOPED_TRACE(mipmaps ? "mip-maps" : "full resolution");
+    st.mipmaps = mipmaps;
+    const wp::Rendered r = wp::render(*runtime_, s, st);
+    EXPECT_EQ(r.report.nonfinite_samples, 0u);
+    for (int y = 0; y < 48; ++y)
+      for (int x = 23; x <= 24; ++x)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(r.image.rgb[3 * (48 * y + x) + c], 1.0f, 1e-6)
+              << "pixel (" << x << ", " << y << ")";
+    // The floor is seen and its black stripes resolved (the rows below the middle).
+    EXPECT_EQ(*std::min_element(r.image.rgb.begin(), r.image.rgb.end()), 0.0f);
+  }
 }
 
 // A small closed scene with every kind of randomness: diffuse, glossy and mirror surfaces, a

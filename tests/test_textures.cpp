@@ -782,14 +782,15 @@ constexpr double kConeScale = 0.125;
 
 // The level a camera ray's cone picks on a plane at a known distance and angle, against the
 // analytic footprint: a pinhole's cone spreads by an eighth of the pixel's angle, g = 1/8 x
-// 2 tan(yfov / 2) / height,
-// so at distance t along the ray it is g t across, and g t / cos on a plane the ray meets at
-// angle theta to its normal; a texture of W x H texels spread over the plane with texel density
+// 2 tan(yfov / 2) / height, so at distance t along the ray it is g t across, the minor axis of its
+// footprint on a plane the ray meets at any angle (the major axis, g t / cos, does not count:
+// kernels/ray_cone.h); a texture of W x H texels spread over the plane with texel density
 // sqrt(W H |det T| A_uv / A_world) per unit length sees that footprint as log2 of (its length x
 // the density) texels: lambda. An orthographic camera's cone is an eighth of the pixel's height,
-// 1/8 x 2 ymag / height, at any distance. Checked for several pixels of tilted views on both
-// coordinate sets (TEXCOORD_1 of the square covers twice the area of TEXCOORD_0) with a scaling
-// transform; tolerance 1e-4 (float log2 and the cone's arithmetic: relative errors of a few 1e-7).
+// 1/8 x 2 ymag / height, at any distance. Checked for several pixels of tilted views (from
+// head-on to about cos 0.15) on both coordinate sets (TEXCOORD_1 of the square covers twice the
+// area of TEXCOORD_0) with a scaling transform; tolerance 1e-4 (float log2 and the cone's
+// arithmetic: relative errors of a few 1e-7).
 TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
   wp::Scene s;
   wp::Material m;
@@ -838,12 +839,11 @@ TEST(RayCone, CameraRayLevelIsTheAnalyticFootprint) {
       const double length =
           kConeScale *
           (v.ortho ? 2.0 * 0.4 / kHeight : 2.0 * std::tan(0.5 * double(cam.yfov)) / kHeight * t);
-      const double across = length / std::abs(d.z);
       for (std::uint32_t ref = 0; ref < 2; ++ref) {
         const wp::TextureRef& tr = s.textures[ref];
         const double det = double(tr.row_u.x) * tr.row_v.y - double(tr.row_u.y) * tr.row_v.x;
         const double uv_area = ref == 1 ? 2.0 : 1.0;  // per unit area of the square
-        want.push_back(std::log2(across * std::sqrt(64.0 * 32.0 * std::abs(det) * uv_area)));
+        want.push_back(std::log2(length * std::sqrt(64.0 * 32.0 * std::abs(det) * uv_area)));
         std::uint32_t tri = first ? 0u : 1u;
         float4 q;
         std::memcpy(&q.x, &tri, 4);

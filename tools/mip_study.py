@@ -41,12 +41,16 @@ import accuracy_lib  # noqa: E402
 REFERENCE_SEED = 0x5EEDF00D
 ASSETS = os.path.join(accuracy_lib.REPO, "..", "shared", "assets")
 ENV = os.path.join(ASSETS, "env", "studio_small_03_1k.hdr")
-# Two textured models seen small: the whole model a few dozen pixels across in a 256 x 256 image.
+# Two textured models seen small (the whole model a few dozen pixels across in a 256 x 256 image),
+# and DamagedHelmet framed whole (wavepath's framing camera, as tools/peers.py --pbr renders it),
+# whose surfaces edge-on to the view test the footprint at grazing angles (kernels/ray_cone.h).
+HELMET = os.path.join(ASSETS, "models", "DamagedHelmet", "DamagedHelmet.glb")
 DEFAULT_CASES = [
-    "DamagedHelmet:%s:--orbit 30,75,14 --env %s"
-    % (os.path.join(ASSETS, "models", "DamagedHelmet", "DamagedHelmet.glb"), ENV),
+    "DamagedHelmet:%s:--orbit 30,75,14 --env %s" % (HELMET, ENV),
     "FlightHelmet:%s:--orbit 200,80,3 --env %s"
     % (os.path.join(ASSETS, "models", "FlightHelmet", "FlightHelmet.gltf"), ENV),
+    "DamagedHelmet, framed:%s:--env %s"
+    % (HELMET, os.path.join(ASSETS, "env", "empty_warehouse_01_1k.hdr")),
 ]
 
 
@@ -55,7 +59,8 @@ def main():
     ap.add_argument("--wavepath", default=os.path.join(accuracy_lib.REPO, "build", "wavepath"))
     ap.add_argument("--case", action="append",
                     help="NAME:SCENE:ARGS, ARGS more wavepath arguments (repeatable; default: "
-                    "DamagedHelmet and FlightHelmet, small, in studio_small_03)")
+                    "DamagedHelmet and FlightHelmet, small, in studio_small_03, and "
+                    "DamagedHelmet framed whole in empty_warehouse_01)")
     ap.add_argument("--size", type=int, default=256, help="image width and height")
     ap.add_argument("--spp", default="1,4,16,64", help="sample counts, comma-separated")
     ap.add_argument("--seeds", type=int, default=3, help="renders per setting and sample count")

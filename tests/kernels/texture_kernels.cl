@@ -86,8 +86,7 @@ __kernel void camera_ray_levels(WP_SCENE_PARAMS, __global const float4* queries,
   const float3 p2 = scene.positions[tv.z].xyz;
   const float3 n = cross(p1 - p0, p2 - p0);
   const float width = cone_width_at(camera_cone(&scene.desc->camera, height), ray.w);
-  const TexPoint tp =
-      texture_point(&scene, tv, q.z, q.w, width, dot(normalize(n), ray.xyz), length(n));
+  const TexPoint tp = texture_point(&scene, tv, q.z, q.w, width, length(n));
   __global const TextureRef* t = scene.textures + as_uint(q.y);
   const float lambda = (t->meta.z == 1u ? tp.lod.y : tp.lod.x) + as_float(t->meta.w);
   out[i] = (float4)(lambda, width, 0.0f, 0.0f);
