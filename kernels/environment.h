@@ -79,11 +79,16 @@ static inline float2 env_map_uv(float3 m, float r_xz) {
                   atan2_poly(r_xz, m.y) * WP_INV_PI);
 }
 
-/* Texel (x, y) seen along map-frame direction m (any length); *sin_theta gets its sin(theta). */
-static inline uint2 env_texel_of(const SceneDesc* d, float3 m, float* sin_theta) {
+/* The map coordinates of world direction dir (any length); *sin_theta gets its sin(theta). */
+static inline float2 env_dir_uv(const SceneDesc* d, float3 dir, float* sin_theta) {
+  const float3 m = env_to_map(d, dir);
   const float r_xz = sqrt(m.x * m.x + m.z * m.z);
-  const float2 uv = env_map_uv(m, r_xz);
   *sin_theta = r_xz / length(m);
+  return env_map_uv(m, r_xz);
+}
+
+/* The texel (x, y) holding map coordinates uv. */
+static inline uint2 env_texel_at(const SceneDesc* d, float2 uv) {
   return (uint2)(min((uint)(uv.x * (float)d->env_width), d->env_width - 1u),
                  min((uint)(uv.y * (float)d->env_height), d->env_height - 1u));
 }
@@ -121,26 +126,24 @@ static inline float3 env_bilinear(const SceneView* scene, float u, float v) {
   return mix(top, bottom, ty);
 }
 
-static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
-  const SceneDesc* d = scene->desc;
-  const float3 m = env_to_map(d, dir);
-  const float2 uv = env_map_uv(m, sqrt(m.x * m.x + m.z * m.z));
-  return env_bilinear(scene, uv.x, uv.y) * d->env_params.x;
+/* The map's radiance at map coordinates uv: the filter's lookup, scaled. */
+static inline float3 env_map_radiance_uv(const SceneView* scene, float2 uv) {
+  return env_bilinear(scene, uv.x, uv.y) * scene->desc->env_params.x;
 }
 #else
-static inline float3 env_map_radiance(const SceneView* scene, float3 dir) {
+static inline float3 env_map_radiance_uv(const SceneView* scene, float2 uv) {
   const SceneDesc* d = scene->desc;
-  float sin_theta;
-  const uint2 t = env_texel_of(d, env_to_map(d, dir), &sin_theta);
+  const uint2 t = env_texel_at(d, uv);
   return scene->env_texels[t.y * d->env_width + t.x].xyz * d->env_params.x;
 }
 #endif
 
-static inline float env_map_pdf(const SceneView* scene, float3 dir) {
+/* The density env_map_sample gives the direction at map coordinates uv, where sin(theta) is
+ * sin_theta: its texel's (env_texel_at). */
+static inline float env_map_pdf_uv(const SceneView* scene, float2 uv, float sin_theta) {
   const SceneDesc* d = scene->desc;
   const uint w = d->env_width;
-  float sin_theta;
-  const uint2 t = env_texel_of(d, env_to_map(d, dir), &sin_theta);
+  const uint2 t = env_texel_at(d, uv);
   __global const float* row = scene->env_conditional + t.y * (w + 1u);
   const float p =
       (scene->env_marginal[t.y + 1u] - scene->env_marginal[t.y]) * (row[t.x + 1u] - row[t.x]);
@@ -177,12 +180,28 @@ static inline float3 env_map_sample(const SceneView* scene, float2 u, float3* di
 
 #endif /* WP_FEATURE_ENVIRONMENT */
 
-static inline float3 env_radiance(const SceneView* scene, float3 dir) {
+/* The radiance arriving along dir and, where want_pdf holds, in *pdf the solid-angle density with
+ * which env_sample produces dir (else 0): env_radiance and env_pdf, the map's coordinates worked
+ * out once for both (an escaped ray needs both; a camera ray or one after a delta lobe only its
+ * radiance). The same values, bit for bit. */
+static inline float3 env_radiance_pdf(const SceneView* scene, float3 dir, bool want_pdf,
+                                      float* pdf) {
 #if WP_FEATURE_ENVIRONMENT
-  if (scene->desc->env_width > 0u) return env_map_radiance(scene, dir);
+  if (scene->desc->env_width > 0u) {
+    float sin_theta;
+    const float2 uv = env_dir_uv(scene->desc, dir, &sin_theta);
+    *pdf = want_pdf ? env_map_pdf_uv(scene, uv, sin_theta) : 0.0f;
+    return env_map_radiance_uv(scene, uv);
+  }
 #endif
   (void)dir;
+  *pdf = want_pdf ? 1.0f / (4.0f * WP_PI) : 0.0f;
   return scene->desc->background.xyz;
+}
+
+static inline float3 env_radiance(const SceneView* scene, float3 dir) {
+  float no_pdf;
+  return env_radiance_pdf(scene, dir, false, &no_pdf);
 }
 
 /* Samples a direction toward the environment; returns its radiance, *pdf is the solid-angle
@@ -201,12 +220,9 @@ static inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, f
 
 /* The solid-angle density with which env_sample produces dir. */
 static inline float env_pdf(const SceneView* scene, float3 dir) {
-#if WP_FEATURE_ENVIRONMENT
-  if (scene->desc->env_width > 0u) return env_map_pdf(scene, dir);
-#endif
-  (void)scene;
-  (void)dir;
-  return 1.0f / (4.0f * WP_PI);
+  float pdf;
+  (void)env_radiance_pdf(scene, dir, true, &pdf);
+  return pdf;
 }
 
 #endif /* WP_ENVIRONMENT_H */

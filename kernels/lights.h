@@ -176,10 +176,17 @@ static inline float triangle_light_pdf(const SceneView* scene, uint inst, uint t
   return scene->light_alias[li].pmf * triangle_solid_angle_pdf(area, dist, cos_light);
 }
 
-/* The pdf with which NEE would have produced an escaped ray's direction. */
-static inline float environment_light_pdf(const SceneView* scene, float3 dir) {
+/* The radiance an escaped ray with direction dir brings and, where want_pdf holds, in *pdf the pdf
+ * with which NEE would have produced that direction (else 0), from one lookup of the map
+ * (env_radiance_pdf). */
+static inline float3 environment_hit(const SceneView* scene, float3 dir, bool want_pdf,
+                                     float* pdf) {
   const uint li = scene->desc->env_light;
-  return li == WP_NO_LIGHT ? 0.0f : scene->light_alias[li].pmf * env_pdf(scene, dir);
+  const bool light = want_pdf && li != WP_NO_LIGHT;
+  float env_pdf_dir;
+  const float3 le = env_radiance_pdf(scene, dir, light, &env_pdf_dir);
+  *pdf = light ? scene->light_alias[li].pmf * env_pdf_dir : 0.0f;
+  return le;
 }
 
 #endif /* WP_LIGHTS_H */

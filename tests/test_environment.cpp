@@ -146,15 +146,26 @@ struct DeviceEnv {
   }
 };
 
-// (env_radiance, env_pdf) of each direction on the device.
+// (env_radiance, env_pdf) of each direction on the device. Every call also checks that
+// env_radiance_pdf without the pdf (a camera ray's escape) gives the same radiance, bit for bit,
+// and pdf 0.
 std::vector<float4> eval(wp::test::KernelHarness& k, DeviceEnv& e,
                          const std::vector<glm::vec3>& dirs) {
   std::vector<float4> in;
   for (const glm::vec3& d : dirs) in.push_back({d.x, d.y, d.z, 0.0f});
-  cl::Buffer din = k.buffer(in), out = k.buffer<float4>(in.size());
+  cl::Buffer din = k.buffer(in), out = k.buffer<float4>(2 * in.size());
   const auto n = static_cast<std::uint32_t>(in.size());
   k.run("env_eval", n, e.desc, e.texels, e.marginal, e.conditional, din, n, out);
-  return k.read<float4>(out, n);
+  const std::vector<float4> both = k.read<float4>(out, 2 * in.size());
+  std::vector<float4> result;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const float4 &r = both[2 * i], &radiance_only = both[2 * i + 1];
+    EXPECT_TRUE(r.x == radiance_only.x && r.y == radiance_only.y && r.z == radiance_only.z)
+        << "env_radiance_pdf without the pdf, direction " << i;
+    EXPECT_EQ(radiance_only.w, 0.0f) << "direction " << i;
+    result.push_back(r);
+  }
+  return result;
 }
 
 // ---- Loading ----------------------------------------------------------------------------------

@@ -45,8 +45,12 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   const float bsdf_pdf = path_bsdf_pdf(paths, slot); /* 0: delta lobe or camera ray */
   const float3 ray_d = path_ray_dir(paths, slot);
   if (!(t < INFINITY)) {
-    const float w = mis_weight_bsdf_hit(bsdf_pdf, environment_light_pdf(scene, ray_d));
-    const float3 le = env_radiance(scene, ray_d);
+    /* NEE's pdf of the direction only where MIS weighs it: not after a camera ray or a delta
+     * lobe (bsdf_pdf 0), whose weight is 1 whatever it is. */
+    float light_pdf;
+    const float3 le = environment_hit(
+        scene, ray_d, WP_STRATEGY == WP_STRATEGY_MIS && bsdf_pdf > 0.0f, &light_pdf);
+    const float w = mis_weight_bsdf_hit(bsdf_pdf, light_pdf);
     path_set_radiance(paths, slot, path_radiance(paths, slot) + beta * le * w);
 #if WP_AOV
     aov_record(paths, slot, clamp(le, 0.0f, 1.0f), (float3)(0.0f));

@@ -19,13 +19,17 @@ inline SceneView env_view(const SceneDesc* d, __global const float4* texels,
       __global const float *conditional
 #define ENV_BIND const SceneView scene = env_view(&desc, texels, marginal, conditional)
 
-/* out[i] = (env_radiance(dirs[i]).rgb, env_pdf(dirs[i])). */
+/* out[2 i] = (env_radiance(dirs[i]).rgb, env_pdf(dirs[i])) (env_radiance_pdf with want_pdf);
+ * out[2 i + 1] the same from env_radiance_pdf without it, as shade_hit asks for a camera ray. */
 __kernel void env_eval(ENV_ARGS, __global const float4* dirs, uint count, __global float4* out) {
   ENV_BIND;
   const uint i = get_global_id(0);
   if (i >= count) return;
   const float3 d = dirs[i].xyz;
-  out[i] = (float4)(env_radiance(&scene, d), env_pdf(&scene, d));
+  out[2 * i] = (float4)(env_radiance(&scene, d), env_pdf(&scene, d));
+  float pdf = -1.0f;
+  const float3 l = env_radiance_pdf(&scene, d, false, &pdf);
+  out[2 * i + 1] = (float4)(l, pdf);
 }
 
 /* Sample i uses u = the project's hash of (i, seed). dir_pdf[i] = (direction, pdf returned by
