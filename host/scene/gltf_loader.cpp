@@ -747,6 +747,7 @@ Scene load_gltf(const std::string& path, const LoadOptions& options) {
     for (std::size_t i = 0; i < model.materials.size(); ++i)
       scene.materials.push_back(
           gltf::convert_material(model, static_cast<int>(i), textures, &clamped));
+    textures.decode();
     for (const std::string& w : clamped) scene.warnings.push_back(path + ": " + w);
     SceneBuilder builder(model, scene, variant);
     std::set<int> placed;

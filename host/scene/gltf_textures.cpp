@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <string>
 
 #include <stb_image.h>
@@ -12,6 +13,7 @@
 
 #include "host/scene/gltf_json.h"
 #include "host/util/error.h"
+#include "host/util/parallel.h"
 
 namespace wp::gltf {
 namespace {
@@ -367,8 +369,9 @@ int TextureTable::add(const TextureInfo& info, bool srgb, const std::string& whe
   return static_cast<int>(scene_.textures.size() - 1);
 }
 
-// Decodes image `index` on first use: from its bufferView (checked against the buffer) or from
-// the bytes keep_encoded_image kept for a URI.
+// Image `index`'s slot in Scene::images, given on first use: its bytes (from its bufferView,
+// checked against the buffer, or those keep_encoded_image kept for a URI) are checked and kept
+// for decode(), which fills the slot.
 int TextureTable::image(int index) {
   int& slot = image_slot_[static_cast<std::size_t>(index)];
   if (slot >= 0) return slot;
@@ -393,14 +396,31 @@ int TextureTable::image(int index) {
   if (size == 0) throw Error(what + ": no image data (file missing or unreadable?)");
   if (size > static_cast<std::size_t>(INT_MAX)) throw Error(what + ": larger than 2 GiB");
   Image out;
-  if (is_webp(bytes, size))
-    decode_webp(bytes, size, what, out);
-  else
-    decode_stb(bytes, size, what, out);
   out.name = in.name.empty() ? in.uri.substr(0, 64) : in.name;
   slot = static_cast<int>(scene_.images.size());
   scene_.images.push_back(std::move(out));
+  pending_.push_back({what, bytes, size});
   return slot;
+}
+
+void TextureTable::decode() {
+  const std::size_t first = scene_.images.size() - pending_.size();
+  std::vector<std::exception_ptr> errors(pending_.size());
+  parallel_for(pending_.size(), [&](std::size_t i) {
+    const Pending& p = pending_[i];
+    try {
+      Image& out = scene_.images[first + i];
+      if (is_webp(p.bytes, p.size))
+        decode_webp(p.bytes, p.size, p.what, out);
+      else
+        decode_stb(p.bytes, p.size, p.what, out);
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  });
+  pending_.clear();
+  for (const std::exception_ptr& e : errors)  // the first image's error, whichever thread was first
+    if (e) std::rethrow_exception(e);
 }
 
 }  // namespace wp::gltf

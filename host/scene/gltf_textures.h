@@ -39,9 +39,13 @@ class TextureTable {
   // The Scene::textures index for `info`, or -1 when info.index < 0 (no texture) or when the
   // texture cannot be used (no image source, a texture coordinate set above 1: a warning says
   // so). `srgb`: colour data (base colour, emissive). Throws wp::Error naming `where` and the
-  // element for a missing texture, image or sampler, a malformed transform or an image that
-  // cannot be read or decoded.
+  // element for a missing texture, image or sampler, a malformed transform or an image whose
+  // bytes cannot be read. The image's pixels come with decode().
   int add(const TextureInfo& info, bool srgb, const std::string& where);
+
+  // Decodes the images add() has given slots in Scene::images since the last call, on all hardware
+  // threads. Throws wp::Error for an image that cannot be decoded (the first such in slot order).
+  void decode();
 
   // The checks of add() for a texture wavepath reads nothing from (e.g. KHR_materials_volume's
   // thicknessTexture): the texture, its sampler and image index and its transform must be valid;
@@ -56,9 +60,18 @@ class TextureTable {
   int image(int index);
   void warn(const std::string& message) const;
 
+  // An image with a slot, not yet decoded: its name for errors and its encoded bytes (the
+  // model's, which outlives the table).
+  struct Pending {
+    std::string what;
+    const unsigned char* bytes;
+    std::size_t size;
+  };
+
   const tinygltf::Model& model_;
   Scene& scene_;
-  std::vector<int> image_slot_;  // glTF image -> Scene::images index, -1 until decoded
+  std::vector<int> image_slot_;  // glTF image -> Scene::images index, -1 until used
+  std::vector<Pending> pending_;
 };
 
 // The KHR_texture_transform of `transform` (may be null: identity) as the rows of TextureRef,

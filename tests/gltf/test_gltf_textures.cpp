@@ -106,6 +106,16 @@ TEST(GltfLoader, TextureErrorsNameTheElement) {
   expect_error(
       with("[{\"source\":0}]", base0, R"("images":[{"uri":"nowhere.png"}])").write("t6.gltf"),
       "image 0 (nowhere.png): no image data");
+  // Images decode together once the materials are read (on all hardware threads); of several
+  // that cannot, the error names the first one used (base colour before emission), whichever
+  // thread got to it.
+  expect_error(with("[{\"source\":1},{\"source\":0}]",
+                    R"({"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},)"
+                    R"("emissiveTexture":{"index":1}})",
+                    R"("images":[{"name":"junk0","uri":"data:image/png;base64,AAAAAAAA"},)"
+                    R"({"name":"junk1","uri":"data:image/png;base64,AAAAAAAA"}])")
+                   .write("t7-two.gltf"),
+               "image 1 'junk1': not a PNG, JPEG or WebP image");
   // PNGs whose chunks claim more than there is, refused before stb_image allocates for them
   // (fuzzing: an IDAT claiming 1.9 GB in a 42 KB file took 2 GiB). stb_image_write writes the
   // signature (8 bytes), IHDR (25; width at 16, height at 20), then IDAT (its length at 33).
