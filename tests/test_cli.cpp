@@ -215,6 +215,27 @@ TEST_F(Cli, NoOpenClDevice) {
                "no OpenCL device");
 }
 
+// Textures are decoded, and PNGs written, by Debian's libstb: libdraco exports a copy of stb_image
+// and stb_image_write of its own, which the binary's calls would bind to where libdraco comes
+// before libstb on its link line (CMakeLists.txt puts libstb first). The dynamic loader says what
+// each of the binary's symbols binds to (glibc's LD_DEBUG, every symbol at start with
+// LD_BIND_NOW).
+TEST_F(Cli, ImagesDecodeThroughLibstb) {
+  const CliRun r = run("--version", "LD_BIND_NOW=1 LD_DEBUG=bindings");
+  ASSERT_EQ(r.status, 0) << r.err;
+  int seen = 0;
+  std::istringstream lines(r.err);
+  for (std::string line; std::getline(lines, line);) {
+    const bool ours = line.find("binding file " WP_WAVEPATH_BIN " ") != std::string::npos;
+    for (const char* symbol : {"`stbi_load_from_memory'", "`stbi_write_png'"})
+      if (ours && line.find(symbol) != std::string::npos) {
+        ++seen;
+        EXPECT_NE(line.find("/libstb.so"), std::string::npos) << line;
+      }
+  }
+  EXPECT_EQ(seen, 2) << r.err.substr(0, 2000);
+}
+
 TEST_F(Cli, KernelThatFailsToBuild) {
   // WAVEPATH_KERNEL_DIR overrides the embedded kernels; one with a syntax error must fail with
   // the first error line, followed by the build log.
