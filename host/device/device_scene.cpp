@@ -164,21 +164,20 @@ void pack_images(const Scene& scene, bool mipmaps, std::vector<dev::TextureImage
   const ImageUses uses = image_uses(scene, mipmaps);
   const std::size_t count = scene.images.size(), batch = host_threads();
   std::vector<std::vector<std::uint8_t>> chains(batch);
+  std::vector<int> levels(batch);
   for (std::size_t first = 0; first < count; first += batch) {
     const std::size_t n = std::min(batch, count - first);
     parallel_for(n, [&](std::size_t k) {
       const std::size_t i = first + k;
-      if (packed_levels(scene.images[i], uses, i) > 1)
-        chains[k] = mip_chain(scene.images[i], uses.colour[i] != 0);
+      levels[k] = packed_levels(scene.images[i], uses, i);
+      if (levels[k] > 1) chains[k] = mip_chain(scene.images[i], uses.colour[i] != 0);
     });
     for (std::size_t k = 0; k < n; ++k) {
-      const std::size_t i = first + k;
-      const Image& img = scene.images[i];
-      const int levels = packed_levels(img, uses, i);
+      const Image& img = scene.images[first + k];
       images.push_back({static_cast<dev::uint>(texels.size()), static_cast<dev::uint>(img.width),
-                        static_cast<dev::uint>(img.height), static_cast<dev::uint>(levels)});
+                        static_cast<dev::uint>(img.height), static_cast<dev::uint>(levels[k])});
       pack_rgba8(img.rgba, texels);
-      if (levels > 1) pack_rgba8(chains[k], texels);
+      if (levels[k] > 1) pack_rgba8(chains[k], texels);
       std::vector<std::uint8_t>().swap(chains[k]);  // freed before the next batch
     }
   }
