@@ -38,6 +38,7 @@ struct CliOptions {
   bool variance = false;
   bool no_bvh_cache = false;
   bool no_prefetch = false;
+  bool no_shadow_packets = false;
   bool no_kernel_cache = false;
   std::string features = "scene";
   std::string tonemap = "aces";

@@ -127,9 +127,17 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
   // instruction and every address space is one.
   const DeviceEntry& device = rt_.device();
-  const bool prefetch =
-      settings.prefetch && !device.gpu && device.platform_name == "Portable Computing Language";
+  const bool pocl_cpu = !device.gpu && device.platform_name == "Portable Computing Language";
+  const bool prefetch = settings.prefetch && pocl_cpu;
   options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
+  // Shadow rays eight to a work-item (kernels/traverse8_packet.h) where they are plain any-hit
+  // queries on the wide layout; only on PoCL's CPU devices, where it was measured
+  // (docs/performance.md, "Shadow rays in packets of eight"). The same image either way.
+  shadow_packet_ = settings.shadow_packets && pocl_cpu && bvh.width == 8 && !features_.instances &&
+                           !features_.alpha && !features_.transmission
+                       ? 8u
+                       : 1u;
+  if (shadow_packet_ > 1) options_ += " -D WP_SHADOW_PACKET=1";
   memory_ = state_memory(settings, features_);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
@@ -260,6 +268,7 @@ void Wavefront::prime_kernels() {
 
 cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
   if (items == 0) return cl::Event();
+  if (stage == Stage::kTraceShadow) items = (items + shadow_packet_ - 1) / shadow_packet_;
   const std::size_t local = local_size_;
   const std::size_t global = local ? (items + local - 1) / local * local : items;
   cl::Kernel& k = kernel(stage);

@@ -84,6 +84,9 @@ struct RenderSettings {
   // Cache hints for the path state ahead in each queue, on PoCL's CPU devices (kernels/features.h,
   // WP_PREFETCH); elsewhere nothing. The same image either way.
   bool prefetch = true;
+  // Shadow rays traced eight to a work-item where they are plain any-hit queries, on PoCL's CPU
+  // devices with the wide BVH (kernels/traverse8_packet.h); elsewhere one each. The same image.
+  bool shadow_packets = true;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Where built kernel programs are cached (host/device/program_cache.h; the command line passes
   // bvh::cache_dir()); empty: nothing is cached.
@@ -263,6 +266,7 @@ class Wavefront {
   std::size_t wave_size_ = 0;
   std::size_t samples_per_wave_ = 1;
   std::size_t local_size_ = 0;
+  std::uint32_t shadow_packet_ = 1;  // shadow rays per work-item (kernels/traverse8_packet.h)
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;
   bool kernel_cached_ = false;

@@ -65,4 +65,42 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
 #endif
 }
 
+#if WP_SHADOW_PACKET
+#if WP_BVH_WIDTH != 8 || WP_BVH_INSTANCES || WP_FEATURE_ALPHA || WP_FEATURE_TRANSMISSION
+#error "WP_SHADOW_PACKET: plain any-hit queries on the wide layout only (traverse8_packet.h)"
+#endif
+#include "traverse8_packet.h"
+
+/* The shadow rays of queue entries [first, first + WP_PACKET) as one packet: the same answers as
+ * trace_shadow_path gives each (traverse8_packet.h). */
+WP_STAGE_FN void trace_shadow_packet(const SceneView* scene, Paths paths, Queues queues,
+                                     uint first) {
+  TraceRay r[WP_PACKET];
+  float tmax[WP_PACKET];
+  uint slots[WP_PACKET];
+  /* The single-ray stage's cache hints, for the entries WP_PREFETCH_AHEAD further on. */
+  for (uint i = 0u; i < WP_PACKET; ++i) {
+    uint ahead;
+    if (prefetch_slot(queues, WP_QUEUE_SHADOW, first + i, &ahead))
+      trace_shadow_prefetch(paths, ahead);
+  }
+  int n = 0;
+  for (; n < WP_PACKET; ++n) {
+    if (!queue_get(queues, WP_QUEUE_SHADOW, first + (uint)n, &slots[n])) break;
+    r[n] =
+        trace_ray(path_shadow_origin(paths, slots[n]), path_shadow_dir(paths, slots[n]), 0.0f, 0u);
+    tmax[n] = path_shadow_tmax(paths, slots[n]);
+  }
+  if (n == 0) return;
+  const PacketRays p = packet_rays(r, tmax, n);
+  const int live = (1 << n) - 1;
+  const int occluded = packet_any_hit(scene, &p, live);
+  for (int i = 0; i < n; ++i) {
+    if (occluded & (1 << i)) continue;
+    path_set_radiance(paths, slots[i],
+                      path_radiance(paths, slots[i]) + path_shadow_radiance(paths, slots[i]));
+  }
+}
+#endif
+
 #endif /* WP_INTEGRATOR_TRACE_SHADOW_H */

@@ -1,0 +1,160 @@
+/* Any-hit traversal of the wide BVH (traverse8.h) for a packet of WP_PACKET rays in one work-item:
+ * the lanes of float8 values are rays, not a node's children, so a node's child box is tested
+ * against all of the packet's rays at once and a triangle likewise.
+ *
+ * The answer of each ray is the one traverse8_walk.def gives it: every lane carries its own mask
+ * down the tree (a child is visited for the rays that entered its box, tested with that ray's own
+ * arithmetic: the same slab and watertight tests, lane by lane, FP_CONTRACT off as in traverse.h),
+ * and an any-hit answer does not depend on the order of the visits (the walk's comment), so which
+ * rays share a packet changes nothing. A ray leaves the packet's work at its first hit.
+ *
+ * Only for programs without instances, alpha and transmission (the shadow stage then is a plain
+ * any-hit query: integrator/trace_shadow.h), on CPU devices with the wide layout: the host picks
+ * it (host/render/wavefront.cpp, shadow_packet) and launches the stage over the queue's length
+ * divided by WP_PACKET. */
+#ifndef WP_TRAVERSE8_PACKET_H
+#define WP_TRAVERSE8_PACKET_H
+
+#define WP_PACKET 8
+
+/* The packet's rays, lane i the TraceRay of ray i (traverse.h), the axes of the watertight frame
+ * as lane masks. */
+typedef struct PacketRays {
+  float8 ox, oy, oz, ix, iy, iz, tmin, tmax;
+  int8 kx1, kx2, ky1, ky2, kz1, kz2; /* axis k is 1 or 2 (else 0: x) */
+  float8 sx, sy, sz, o_kx, o_ky, o_kz;
+} PacketRays;
+
+/* The packet of rays r[0, n) (n <= WP_PACKET), each with maximum distance tmax[i]; lanes from n on
+ * copy lane 0 and are never live. */
+static inline PacketRays packet_rays(const TraceRay* r, const float* tmax, int n) {
+  float ox[WP_PACKET], oy[WP_PACKET], oz[WP_PACKET], ix[WP_PACKET], iy[WP_PACKET], iz[WP_PACKET],
+      tmin[WP_PACKET], tm[WP_PACKET], sx[WP_PACKET], sy[WP_PACKET], sz[WP_PACKET], okx[WP_PACKET],
+      oky[WP_PACKET], okz[WP_PACKET];
+  int kx[WP_PACKET], ky[WP_PACKET], kz[WP_PACKET];
+  for (int i = 0; i < WP_PACKET; ++i) {
+    const int k = i < n ? i : 0;
+    ox[i] = r[k].ox, oy[i] = r[k].oy, oz[i] = r[k].oz;
+    ix[i] = r[k].ix, iy[i] = r[k].iy, iz[i] = r[k].iz;
+    tmin[i] = r[k].tmin, tm[i] = tmax[k];
+    kx[i] = r[k].kx, ky[i] = r[k].ky, kz[i] = r[k].kz;
+    sx[i] = r[k].sx, sy[i] = r[k].sy, sz[i] = r[k].sz;
+    okx[i] = r[k].o_kx, oky[i] = r[k].o_ky, okz[i] = r[k].o_kz;
+  }
+  PacketRays p;
+  p.ox = vload8(0, ox), p.oy = vload8(0, oy), p.oz = vload8(0, oz);
+  p.ix = vload8(0, ix), p.iy = vload8(0, iy), p.iz = vload8(0, iz);
+  p.tmin = vload8(0, tmin), p.tmax = vload8(0, tm);
+  const int8 ax = vload8(0, kx), ay = vload8(0, ky), az = vload8(0, kz);
+  p.kx1 = ax == 1, p.kx2 = ax == 2, p.ky1 = ay == 1, p.ky2 = ay == 2, p.kz1 = az == 1,
+  p.kz2 = az == 2;
+  p.sx = vload8(0, sx), p.sy = vload8(0, sy), p.sz = vload8(0, sz);
+  p.o_kx = vload8(0, okx), p.o_ky = vload8(0, oky), p.o_kz = vload8(0, okz);
+  return p;
+}
+
+/* Each lane's coordinate `k` (k1, k2: its masks) of the point (x, y, z). */
+static inline float8 packet_axis(float x, float y, float z, int8 k1, int8 k2) {
+  return select(select((float8)(x), (float8)(y), k1), (float8)(z), k2);
+}
+
+/* The lanes in `live` whose ray hits triangle j of block b within (tmin, tmax): block_test's
+ * arithmetic (traverse8.h) for one triangle and eight rays. */
+static inline int packet_triangle(const PacketRays* p, __global const TriBlock4* b, int j,
+                                  int live) {
+  __global const float* v0 = (__global const float*)b->v0;
+  __global const float* v1 = (__global const float*)b->v1;
+  __global const float* v2 = (__global const float*)b->v2;
+  const float v0x = v0[j], v0y = v0[4 + j], v0z = v0[8 + j];
+  const float v1x = v1[j], v1y = v1[4 + j], v1z = v1[8 + j];
+  const float v2x = v2[j], v2y = v2[4 + j], v2z = v2[8 + j];
+  const float8 az = packet_axis(v0x, v0y, v0z, p->kz1, p->kz2) - p->o_kz;
+  const float8 bz = packet_axis(v1x, v1y, v1z, p->kz1, p->kz2) - p->o_kz;
+  const float8 cz = packet_axis(v2x, v2y, v2z, p->kz1, p->kz2) - p->o_kz;
+  const float8 ax = (packet_axis(v0x, v0y, v0z, p->kx1, p->kx2) - p->o_kx) - p->sx * az;
+  const float8 ay = (packet_axis(v0x, v0y, v0z, p->ky1, p->ky2) - p->o_ky) - p->sy * az;
+  const float8 bx = (packet_axis(v1x, v1y, v1z, p->kx1, p->kx2) - p->o_kx) - p->sx * bz;
+  const float8 by = (packet_axis(v1x, v1y, v1z, p->ky1, p->ky2) - p->o_ky) - p->sy * bz;
+  const float8 cx = (packet_axis(v2x, v2y, v2z, p->kx1, p->kx2) - p->o_kx) - p->sx * cz;
+  const float8 cy = (packet_axis(v2x, v2y, v2z, p->ky1, p->ky2) - p->o_ky) - p->sy * cz;
+  const float8 u_ = cx * by - cy * bx;
+  const float8 v_ = ax * cy - ay * cx;
+  const float8 w_ = bx * ay - by * ax;
+  const int8 mixed =
+      ((u_ < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f)) & ((u_ > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f));
+  const float8 det = u_ + v_ + w_;
+  const uint flags = ((__global const uint*)&b->flags)[j];
+  const int8 cull = (flags & WP_TRI_CULL_BACKFACE) ? det < 0.0f : (int8)(0);
+  const int inside = live & lane_bits8(~mixed & (det != 0.0f) & ~cull);
+  if (inside == 0) return 0;
+  const float8 inv = 1.0f / det;
+  const float8 t = (u_ * (p->sz * az) + v_ * (p->sz * bz) + w_ * (p->sz * cz)) * inv;
+  return inside & lane_bits8((t > p->tmin) & (t < p->tmax));
+}
+
+/* The lanes in `live` that some triangle of leaf ~ref occludes. */
+static inline int packet_leaf(const SceneView* scene, const PacketRays* p, int ref, int live) {
+  const int c = ~ref;
+  __global const TriBlock4* b = (__global const TriBlock4*)scene->tris + (c >> 2);
+  const int blocks = (c & 3) + 1;
+  int hit = 0;
+  for (int i = 0; i < blocks; ++i) {
+    __global const uint* prim = (__global const uint*)&b[i].prim;
+    for (int j = 0; j < 4; ++j) {
+      if (prim[j] == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
+      hit |= packet_triangle(p, b + i, j, live & ~hit);
+      if (hit == live) return hit;
+    }
+  }
+  return hit;
+}
+
+/* The lanes of `live` whose ray is occluded: any hit in (tmin, tmax), from the root. */
+static inline int packet_any_hit(const SceneView* scene, const PacketRays* p, int live) {
+  __global const BvhNode8* nodes = (__global const BvhNode8*)scene->nodes;
+  int stack_node[WP_BVH8_STACK_SIZE], stack_mask[WP_BVH8_STACK_SIZE];
+  int sp = 0, node = 0, mask = live, occluded = 0;
+  for (;;) {
+    __global const BvhNode8* n = nodes + node;
+    __global const float* lo_x = (__global const float*)&n->lo_x;
+    __global const float* hi_x = (__global const float*)&n->hi_x;
+    __global const float* lo_y = (__global const float*)&n->lo_y;
+    __global const float* hi_y = (__global const float*)&n->hi_y;
+    __global const float* lo_z = (__global const float*)&n->lo_z;
+    __global const float* hi_z = (__global const float*)&n->hi_z;
+    __global const int* cl = (__global const int*)&n->child;
+    for (int i = 0; i < 8; ++i) {
+      const int c = cl[i];
+      if (c == 0) continue; /* an unused slot */
+      /* The walk's slab test, per ray: min and max of both planes' distances are the near and
+       * far plane's (lo <= hi), the values traverse8_walk.def picks by the direction's sign. */
+      const float8 t0x = (lo_x[i] - p->ox) * p->ix, t1x = (hi_x[i] - p->ox) * p->ix;
+      const float8 t0y = (lo_y[i] - p->oy) * p->iy, t1y = (hi_y[i] - p->oy) * p->iy;
+      const float8 t0z = (lo_z[i] - p->oz) * p->iz, t1z = (hi_z[i] - p->oz) * p->iz;
+      const float8 tnear =
+          max8(max8(min8(t0x, t1x), min8(t0y, t1y)), max8(min8(t0z, t1z), p->tmin));
+      const float8 tfar = min8(min8(max8(t0x, t1x), max8(t0y, t1y)), min8(max8(t0z, t1z), p->tmax));
+      const int entered = mask & lane_bits8(tnear <= tfar);
+      if (entered == 0) continue;
+      if (c < 0) {
+        occluded |= packet_leaf(scene, p, c, entered);
+        if (occluded == live) return occluded;
+        mask &= ~occluded;
+      } else {
+        stack_node[sp] = c;
+        stack_mask[sp] = entered;
+        ++sp;
+      }
+    }
+    /* Next: the top entry with rays still looking. */
+    for (;;) {
+      if (sp == 0) return occluded;
+      --sp;
+      mask = stack_mask[sp] & ~occluded;
+      if (mask != 0) break;
+    }
+    node = stack_node[sp];
+  }
+}
+
+#endif /* WP_TRAVERSE8_PACKET_H */
