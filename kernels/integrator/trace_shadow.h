@@ -26,6 +26,12 @@ static inline void trace_shadow_prefetch(Paths paths, uint slot) {
   prefetch_path(paths, radiance, slot);
 }
 
+/* A shadow ray that reaches its light unhindered: the path's radiance takes what the ray carries.
+ */
+static inline void shadow_ray_arrives(Paths paths, uint slot) {
+  path_set_radiance(paths, slot, path_radiance(paths, slot) + path_shadow_radiance(paths, slot));
+}
+
 WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch launch, uint slot) {
   const float3 o = path_shadow_origin(paths, slot), d = path_shadow_dir(paths, slot);
   const float tmax_light = path_shadow_tmax(paths, slot);
@@ -60,8 +66,7 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
 #else
   const TraceRay ray = trace_ray(o, d, 0.0f, key);
   TraceHit hit;
-  if (!bvh_trace(scene, &ray, tmax_light, &hit, true))
-    path_set_radiance(paths, slot, path_radiance(paths, slot) + path_shadow_radiance(paths, slot));
+  if (!bvh_trace(scene, &ray, tmax_light, &hit, true)) shadow_ray_arrives(paths, slot);
 #endif
 }
 
@@ -95,11 +100,8 @@ WP_STAGE_FN void trace_shadow_packet(const SceneView* scene, Paths paths, Queues
   const PacketRays p = packet_rays(r, tmax, n);
   const int live = (1 << n) - 1;
   const int occluded = packet_any_hit(scene, &p, live);
-  for (int i = 0; i < n; ++i) {
-    if (occluded & (1 << i)) continue;
-    path_set_radiance(paths, slots[i],
-                      path_radiance(paths, slots[i]) + path_shadow_radiance(paths, slots[i]));
-  }
+  for (int i = 0; i < n; ++i)
+    if (!(occluded & (1 << i))) shadow_ray_arrives(paths, slots[i]);
 }
 #endif
 
