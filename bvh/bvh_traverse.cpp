@@ -29,15 +29,16 @@ detail::TriangleData triangle_data(const dev::IsectTri& t) {
       detail::float_bits(t.v0.w)};
 }
 
-// Intersects leaf reference `ref` (count triangles) against (tmin, hit.t); with `any`, stops at
-// the first hit. Returns whether anything was hit.
-bool leaf_test(const Bvh& bvh, const PreparedRay& r, std::int32_t ref, std::int32_t count, Hit& hit,
-               float& tmax, bool any) {
+// Intersects leaf reference `ref` (count triangles), entered at `tleaf`, against the closest hit so
+// far (tmax its distance; triangle_test's rule); with `any`, stops at the first hit. Returns
+// whether anything was hit.
+bool leaf_test(const Bvh& bvh, const PreparedRay& r, std::int32_t ref, std::int32_t count,
+               float tleaf, Hit& hit, float& tmax, bool any) {
   bool found = false;
   const std::size_t first = static_cast<std::size_t>(~ref);
   for (std::int32_t i = 0; i < count; ++i) {
     const dev::IsectTri& tri = bvh.triangles[first + static_cast<std::size_t>(i)];
-    if (detail::triangle_test(r, triangle_data(tri), tmax, hit)) {
+    if (detail::triangle_test(r, triangle_data(tri), tleaf, tmax, hit)) {
       found = true;
       tmax = hit.t;
       if (any) return true;
@@ -67,11 +68,11 @@ Hit trace_binary(const Bvh& bvh, const Ray& ray, bool any, std::int32_t root) {
     float t0 = box_entry(r, a.x, a.y, a.z, a.w, z.x, z.y, tmax);
     float t1 = box_entry(r, b.x, b.y, b.z, b.w, z.z, z.w, tmax);
     if (t0 < kMiss && link.x < 0) {
-      if (leaf_test(bvh, r, link.x, link.z, hit, tmax, any) && any) return hit;
+      if (leaf_test(bvh, r, link.x, link.z, t0, hit, tmax, any) && any) return hit;
       t0 = kMiss;
     }
     if (t1 < kMiss && link.y < 0) {
-      if (leaf_test(bvh, r, link.y, link.w, hit, tmax, any) && any) return hit;
+      if (leaf_test(bvh, r, link.y, link.w, t1, hit, tmax, any) && any) return hit;
       t1 = kMiss;
     }
     if (t0 < kMiss && t1 < kMiss) {
@@ -107,7 +108,8 @@ bool occluded(const Bvh& bvh, const Ray& ray) {
 }
 
 bool intersect_triangle(const dev::IsectTri& tri, const Ray& ray, float tmax, Hit& hit) {
-  return detail::triangle_test(PreparedRay(ray), triangle_data(tri), tmax, hit);
+  // No leaf: its distance is t itself (tleaf = tmin < t).
+  return detail::triangle_test(PreparedRay(ray), triangle_data(tri), ray.tmin, tmax, hit);
 }
 
 }  // namespace wp::bvh

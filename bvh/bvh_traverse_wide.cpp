@@ -48,18 +48,19 @@ TriangleData triangle_data(const dev::TriBlock4& b, int i) {
   return t;
 }
 
-// Intersects the leaf `child` (< 0) against (tmin, tmax), lowering tmax at each closer hit; with
-// `any`, stops at the first hit. Unused lanes (zero area: det = 0) never hit. Returns whether
+// Intersects the leaf `child` (< 0), entered at `tleaf`, against the closest hit so far (tmax its
+// distance), lowering tmax at each closer hit (triangle_test's rule); with `any`, stops at the
+// first hit. Unused lanes (zero area: det = 0) never hit. Returns whether
 // anything was hit.
-bool leaf_test(const Bvh& bvh, const PreparedRay& r, std::int32_t child, Hit& hit, float& tmax,
-               bool any) {
+bool leaf_test(const Bvh& bvh, const PreparedRay& r, std::int32_t child, float tleaf, Hit& hit,
+               float& tmax, bool any) {
   const std::int32_t c = ~child;
   const auto first = static_cast<std::size_t>(c >> 2);
   const std::size_t count = static_cast<std::size_t>(c & 3) + 1;
   bool found = false;
   for (std::size_t b = first; b < first + count; ++b) {
     for (int i = 0; i < 4; ++i) {
-      if (triangle_test(r, triangle_data(bvh.blocks[b], i), tmax, hit)) {
+      if (triangle_test(r, triangle_data(bvh.blocks[b], i), tleaf, tmax, hit)) {
         found = true;
         tmax = hit.t;
         if (any) return true;
@@ -114,7 +115,7 @@ Hit trace_wide(const Bvh& bvh, const Ray& ray, bool any, std::int32_t root) {
       if (!(entered >> i & 1)) continue;
       const std::int32_t child = n.child.s[i];
       if (child < 0) {
-        if (leaf_test(bvh, r, child, hit, tmax, any) && any) return hit;
+        if (leaf_test(bvh, r, child, tnear[i], hit, tmax, any) && any) return hit;
       } else if (child > 0) {
         insert(inner, count, Entry{child, tnear[i]});
       }

@@ -10,7 +10,22 @@
 //               tfar  = min(min(max(t0x,t1x), max(t0y,t1y)), min(max(t0z,t1z), tmax_current))
 //               entered iff tnear <= tfar
 //   triangle    the watertight test of Woop, Benthin and Wald (JCGT 2013), see triangle_test();
-//               a hit iff tmin < t < tmax_current, so a later triangle replaces only if closer.
+//               its distance d = max(t, tleaf), tleaf the slab tnear of the leaf box it is
+//               found in; a candidate iff tmin < t, accepted iff (d, prim) < (d_best, prim_best)
+//               lexicographically (d < tmax before any hit), see hit_is_closer().
+//
+// Why d and the index: the closest hit must not depend on the order the walk visits nodes in, so
+// that walks of different orders (nearest child first per ray, a packet's order for eight rays:
+// kernels/traverse8_packet.h) give every ray the same answer. Two things would make it depend:
+// (1) two triangles at the same distance (a ray through an edge both share hits both), where
+// "the first found" wins; the lower scene triangle index wins instead. (2) Rounding: a box whose
+// computed tnear exceeds the computed t of a triangle inside it by an ulp is culled by a hit
+// between the two in one order and not in another. With d >= tleaf no box is ever culled by a hit
+// its own content beats: boxes nest (bvh_check: every child box lies inside its parent's) and the
+// slab distance (plane - o) * inv_d is monotone in the plane for a given ray, so every ancestor's
+// computed tnear is <= its leaf's. The best hit's boxes are then entered whatever the order, and
+// the answer is the least (d, prim) over all triangles in the leaves the ray enters within tmax.
+// The hit record's t is d, at most a few ulps beyond t (a rounding of the same distance).
 #pragma once
 
 #include <cmath>
@@ -90,6 +105,12 @@ inline bool slab_test(const PreparedRay& r, float lox, float hix, float loy, flo
   return tnear <= tfar;
 }
 
+// The closest-hit rule (the top of this file): a hit at distance d on triangle `prim` replaces
+// `hit`, whose distance is `tmax` (the ray's tmax while there is none), iff (d, prim) is smaller.
+inline bool hit_is_closer(float d, std::uint32_t prim, float tmax, const Hit& hit) {
+  return d < tmax || (hit.hit && d == tmax && prim < hit.triangle);
+}
+
 // One stored triangle, whichever layout it comes from: v[vertex][axis].
 struct TriangleData {
   float v[3][3];
@@ -107,9 +128,11 @@ struct TriangleData {
 // triangles rather than neither). det = U + V + W > 0 is a front-face hit (cross(v1 - v0,
 // v2 - v0) faces against d); barycentrics u = V / det (of v1), v = W / det (of v2). No fused
 // multiply-adds anywhere (see the top of this file): with them the two products of an edge
-// function round differently and the symmetry is lost. Returns whether tmin < t < tmax, and then
-// fills `hit`.
-inline bool triangle_test(const PreparedRay& r, const TriangleData& tri, float tmax, Hit& hit) {
+// function round differently and the symmetry is lost. Returns whether tmin < t and the hit's
+// (d, prim), d = max(t, tleaf), is closer than `hit`'s (hit_is_closer, `tmax` its distance), and
+// then fills `hit` with t = d.
+inline bool triangle_test(const PreparedRay& r, const TriangleData& tri, float tleaf, float tmax,
+                          Hit& hit) {
   const int kx = r.f.kx, ky = r.f.ky, kz = r.f.kz;
   const float az = tri.v[0][kz] - r.o_kz, bz = tri.v[1][kz] - r.o_kz, cz = tri.v[2][kz] - r.o_kz;
   const float ax = (tri.v[0][kx] - r.o_kx) - r.f.sx * az;
@@ -127,9 +150,11 @@ inline bool triangle_test(const PreparedRay& r, const TriangleData& tri, float t
   if ((tri.flags & WP_TRI_CULL_BACKFACE) && det < 0.0f) return false;
   const float inv = 1.0f / det;
   const float t = (u_ * (r.f.sz * az) + v_ * (r.f.sz * bz) + w_ * (r.f.sz * cz)) * inv;
-  if (!(t > r.tmin && t < tmax)) return false;
+  if (!(t > r.tmin)) return false;
+  const float d = fmax2(t, tleaf);
+  if (!hit_is_closer(d, tri.prim, tmax, hit)) return false;
   hit.hit = true;
-  hit.t = t, hit.u = v_ * inv, hit.v = w_ * inv;
+  hit.t = d, hit.u = v_ * inv, hit.v = w_ * inv;
   hit.triangle = tri.prim;
   return true;
 }

@@ -8,9 +8,13 @@
 #ifndef WP_BVH_INSTANCES
 #define WP_BVH_INSTANCES 0 /* a two-level BVH (shared/bvh_layout.h): the scene's structure */
 #endif
-/* Shadow rays traced eight to a work-item (traverse8_packet.h): the host's choice. */
+/* Shadow rays and closest-hit rays traced eight to a work-item (traverse8_packet.h): the host's
+ * choice. */
 #ifndef WP_SHADOW_PACKET
 #define WP_SHADOW_PACKET 0
+#endif
+#ifndef WP_CLOSEST_PACKET
+#define WP_CLOSEST_PACKET 0
 #endif
 #ifndef WP_FEATURE_PUNCTUAL_LIGHTS
 #define WP_FEATURE_PUNCTUAL_LIGHTS 1 /* point, spot or directional lights */

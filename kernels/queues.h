@@ -33,6 +33,14 @@ static inline bool queue_get(Queues qs, uint q, uint index, uint* slot) {
   return true;
 }
 
+/* The slots of entries [first, first + count) of queue q that exist (a packet of rays,
+ * traverse8_packet.h); returns how many. */
+static inline int queue_get_run(Queues qs, uint q, uint first, int count, uint* slots) {
+  int n = 0;
+  while (n < count && queue_get(qs, q, first + (uint)n, &slots[n])) ++n;
+  return n;
+}
+
 /* Two queue_push_group calls (below) in one: slot goes to queue qa where push_a holds and to queue
  * qb where push_b holds, with one scan of both flags packed in a word (a group's ranks fit in 16
  * bits: WP_GROUP_SIZE <= 1024), so half the barriers and scans of two calls. Each queue's entries

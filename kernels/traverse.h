@@ -84,9 +84,18 @@ static inline float box_entry(const TraceRay* r, float lox, float hix, float loy
   return tnear <= tfar ? tnear : INFINITY;
 }
 
-/* The watertight test against one stored triangle. On a hit closer than hit->t, updates *hit. */
+/* The closest-hit rule (bvh/traverse_common.h, hit_is_closer): a hit at distance d on triangle
+ * `prim` replaces *hit iff (d, prim) is smaller; before any hit hit->t is the ray's tmax and
+ * hit->tri 0 (bvh_trace), which no index is below. The same answer in any visiting order (the
+ * reference's comment), which packets of rays rely on (traverse8_packet.h). */
+static inline bool hit_is_closer(float d, uint prim, const TraceHit* hit) {
+  return d < hit->t || (d == hit->t && prim < hit->tri);
+}
+
+/* The watertight test against one stored triangle of a leaf entered at `tleaf`: at distance
+ * max(t, tleaf) (the reference's d), updates *hit when that is closer. */
 static inline bool triangle_test(const SceneView* scene, const TraceRay* r,
-                                 __global const IsectTri* tri, TraceHit* hit) {
+                                 __global const IsectTri* tri, float tleaf, TraceHit* hit) {
   __global const float* v0 = (__global const float*)&tri->v0;
   __global const float* v1 = (__global const float*)&tri->v1;
   __global const float* v2 = (__global const float*)&tri->v2;
@@ -107,25 +116,28 @@ static inline bool triangle_test(const SceneView* scene, const TraceRay* r,
   if ((flags & WP_TRI_CULL_BACKFACE) && det < 0.0f) return false;
   const float inv = 1.0f / det;
   const float t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;
-  if (!(t > r->tmin && t < hit->t)) return false;
-  const float u = v_ * inv, v = w_ * inv;
+  if (!(t > r->tmin)) return false;
+  const float d = t < tleaf ? tleaf : t; /* the reference's fmax2 */
   const uint prim = as_uint(tri->v0.w);
+  if (!hit_is_closer(d, prim, hit)) return false;
+  const float u = v_ * inv, v = w_ * inv;
 #if WP_FEATURE_ALPHA
   if ((flags & WP_TRI_ALPHA) && !alpha_passes(scene, prim, u, v, r->alpha_key)) return false;
 #else
   (void)scene;
 #endif
-  hit->t = t, hit->u = u, hit->v = v, hit->tri = prim;
+  hit->t = d, hit->u = u, hit->v = v, hit->tri = prim;
   return true;
 }
 
-/* Intersects the leaf [first, first + count); with `any`, stops at the first hit. */
+/* Intersects the leaf [first, first + count), entered at `tleaf`; with `any`, stops at the first
+ * hit. */
 static inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref, int count,
-                             TraceHit* hit, bool any) {
+                             float tleaf, TraceHit* hit, bool any) {
   bool found = false;
   __global const IsectTri* tri = scene->tris + ~ref;
   for (int i = 0; i < count; ++i) {
-    if (triangle_test(scene, r, tri + i, hit)) {
+    if (triangle_test(scene, r, tri + i, tleaf, hit)) {
       found = true;
       if (any) return true;
     }
@@ -142,6 +154,9 @@ static inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref,
 #define WP_WALK_NAME mesh_walk
 #define WP_WALK_LEAF leaf8_test
 #include "traverse8_walk.def"
+/* Here rather than in the stages that use it (WP_SHADOW_PACKET, WP_CLOSEST_PACKET): the host
+ * expands each header at its first #include whatever #if it stands in (kernel_sources.cpp). */
+#include "traverse8_packet.h"
 #else
 #define WP_WALK_NAME mesh_walk
 #define WP_WALK_LEAF leaf_test
@@ -189,8 +204,9 @@ static inline bool instances_test(const SceneView* scene, const TraceRay* r,
 
 #if WP_BVH_WIDTH == 8
 /* A top-level leaf ~ref: 4 instance references per block (bvh_layout.h). */
-static inline bool instance_leaf8(const SceneView* scene, const TraceRay* r, int ref, TraceHit* hit,
-                                  bool any) {
+static inline bool instance_leaf8(const SceneView* scene, const TraceRay* r, int ref, float tleaf,
+                                  TraceHit* hit, bool any) {
+  (void)tleaf; /* each instance's walk has its own leaves */
   const int c = ~ref;
   return instances_test(scene, r, scene->instance_refs + 4 * (c >> 2), 4 * ((c & 3) + 1), hit, any);
 }
@@ -200,7 +216,8 @@ static inline bool instance_leaf8(const SceneView* scene, const TraceRay* r, int
 #else
 /* A top-level leaf: `count` instance references from ~ref. */
 static inline bool instance_leaf(const SceneView* scene, const TraceRay* r, int ref, int count,
-                                 TraceHit* hit, bool any) {
+                                 float tleaf, TraceHit* hit, bool any) {
+  (void)tleaf; /* each instance's walk has its own leaves */
   return instances_test(scene, r, scene->instance_refs + ~ref, count, hit, any);
 }
 #define WP_WALK_NAME top_walk
@@ -224,6 +241,7 @@ static inline uint trace_hit_instance(const TraceHit* hit) {
 static inline bool bvh_trace(const SceneView* scene, const TraceRay* r, float tmax, TraceHit* hit,
                              bool any) {
   hit->t = tmax;
+  hit->tri = 0u; /* hit_is_closer: no tie with "no hit" */
 #if WP_BVH_INSTANCES
   hit->inst = WP_NO_INSTANCE;
   return top_walk(scene, r, 0, hit, any);

@@ -12,10 +12,11 @@
 #ifndef WP_TRAVERSE8_H
 #define WP_TRAVERSE8_H
 
-/* The watertight test (bvh/traverse_common.h) on the 4 lanes of a block; updates *hit with the
- * closest lane that is closer. */
+/* The watertight test (bvh/traverse_common.h) on the 4 lanes of a block of a leaf entered at
+ * `tleaf`; updates *hit with the closest lane that is closer (hit_is_closer, traverse.h), each at
+ * distance max(t, tleaf). */
 static inline bool block_test(const SceneView* scene, const TraceRay* r,
-                              __global const TriBlock4* b, TraceHit* hit) {
+                              __global const TriBlock4* b, float tleaf, TraceHit* hit) {
   const float4 az = b->v0[r->kz] - r->o_kz, bz = b->v1[r->kz] - r->o_kz,
                cz = b->v2[r->kz] - r->o_kz;
   const float4 ax = (b->v0[r->kx] - r->o_kx) - r->sx * az;
@@ -39,12 +40,13 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
   const float4 t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;
   const float4 u = v_ * inv, v = w_ * inv;
   int4 ok = inside & (t > r->tmin);
+  const float4 d = select(t, (float4)(tleaf), t < tleaf); /* the reference's fmax2 */
 #if WP_FEATURE_ALPHA
   if (!any(ok)) return false;
-  /* Lanes in order, strictly closer replaces: the reference's rule. */
+  /* Lanes in order, each by the reference's rule. */
   float tl[4], ul[4], vl[4];
   int okl[4];
-  vstore4(t, 0, tl);
+  vstore4(d, 0, tl);
   vstore4(u, 0, ul);
   vstore4(v, 0, vl);
   vstore4(ok, 0, okl);
@@ -54,7 +56,7 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
   vstore4(flags, 0, fl);
   bool found = false;
   for (int i = 0; i < 4; ++i) {
-    if (!okl[i] || !(tl[i] < hit->t)) continue;
+    if (!okl[i] || !hit_is_closer(tl[i], pl[i], hit)) continue;
     if ((fl[i] & WP_TRI_ALPHA) && !alpha_passes(scene, pl[i], ul[i], vl[i], r->alpha_key)) continue;
     hit->t = tl[i], hit->u = ul[i], hit->v = vl[i], hit->tri = pl[i];
     found = true;
@@ -62,34 +64,37 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
   return found;
 #else
   (void)scene;
-  /* Without alpha that rule picks the smallest t below the closest so far, the lowest lane among
-   * equals: found here without a branch per lane, the same hit (a branch per lane was slower on
-   * PoCL: docs/performance.md, "Closest lane of a triangle block"). */
-  ok &= t < hit->t;
+  /* Without alpha that rule picks the least (d, prim) among the lanes closer than the hit so far:
+   * found here without a branch per lane, the same hit (a branch per lane was slower on PoCL:
+   * docs/performance.md, "Closest lane of a triangle block"). */
+  const uint4 prim = b->prim;
+  ok &= (d < hit->t) | ((d == hit->t) & (prim < hit->tri));
   if (!any(ok)) return false;
-  const float4 tm = select((float4)(INFINITY), t, ok);
+  const float4 tm = select((float4)(INFINITY), d, ok);
   const float2 m2 = fmin(tm.lo, tm.hi);
   const float m = fmin(m2.x, m2.y);
-  const int4 at = tm == m; /* lanes left out hold INFINITY, and m < hit->t */
+  /* Lanes left out hold INFINITY, and m <= hit->t < INFINITY; the lowest index among them. */
+  const uint4 pm = select((uint4)(0xffffffffu), prim, ok & (tm == m));
+  const uint2 p2 = min(pm.lo, pm.hi);
+  const uint p = min(p2.x, p2.y);
+  const int4 at = ok & (tm == m) & (prim == p);
   const int lane = at.x ? 0 : at.y ? 1 : at.z ? 2 : 3;
   float ul[4], vl[4];
-  uint pl[4];
   vstore4(u, 0, ul);
   vstore4(v, 0, vl);
-  vstore4(b->prim, 0, pl);
-  hit->t = m, hit->u = ul[lane], hit->v = vl[lane], hit->tri = pl[lane];
+  hit->t = m, hit->u = ul[lane], hit->v = vl[lane], hit->tri = p;
   return true;
 #endif
 }
 
-static inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref, TraceHit* hit,
-                              bool any_hit) {
+static inline bool leaf8_test(const SceneView* scene, const TraceRay* r, int ref, float tleaf,
+                              TraceHit* hit, bool any_hit) {
   const int c = ~ref;
   __global const TriBlock4* b = (__global const TriBlock4*)scene->tris + (c >> 2);
   const int blocks = (c & 3) + 1;
   bool found = false;
   for (int i = 0; i < blocks; ++i) {
-    if (block_test(scene, r, b + i, hit)) {
+    if (block_test(scene, r, b + i, tleaf, hit)) {
       found = true;
       if (any_hit) return true;
     }

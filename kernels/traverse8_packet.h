@@ -1,17 +1,19 @@
-/* Any-hit traversal of the wide BVH (traverse8.h) for a packet of WP_PACKET rays in one work-item:
+/* Traversal of the wide BVH (traverse8.h) for a packet of WP_PACKET rays in one work-item:
  * the lanes of float8 values are rays, not a node's children, so a node's child box is tested
  * against all of the packet's rays at once and a triangle likewise.
  *
  * The answer of each ray is the one traverse8_walk.def gives it: every lane carries its own mask
  * down the tree (a child is visited for the rays that entered its box, tested with that ray's own
  * arithmetic: the same slab and watertight tests, lane by lane, FP_CONTRACT off as in traverse.h),
- * and an any-hit answer does not depend on the order of the visits (the walk's comment), so which
- * rays share a packet changes nothing. A ray leaves the packet's work at its first hit.
+ * and neither an any-hit answer nor a closest hit depends on the order of the visits (the closest
+ * by its rule, bvh/traverse_common.h: the least distance, then the lowest triangle index, the
+ * distance never below the entry of the leaf it is found in), so which rays share a packet
+ * changes nothing. A ray leaves an any-hit packet's work at its first hit.
  *
- * Only for programs without instances, alpha and transmission (the shadow stage then is a plain
- * any-hit query: integrator/trace_shadow.h), on CPU devices with the wide layout: the host picks
- * it (host/render/wavefront.cpp, shadow_packet) and launches the stage over the queue's length
- * divided by WP_PACKET. */
+ * Only for programs without instances and alpha (and, for shadow rays, transmission: they are
+ * then plain any-hit queries, integrator/trace_shadow.h), on CPU devices with the wide layout: the
+ * host picks them (host/render/wavefront.cpp, packet stages) and launches those stages over the
+ * queue's length divided by WP_PACKET. */
 #ifndef WP_TRAVERSE8_PACKET_H
 #define WP_TRAVERSE8_PACKET_H
 
@@ -58,10 +60,15 @@ static inline float8 packet_axis(float x, float y, float z, int8 k1, int8 k2) {
   return select(select((float8)(x), (float8)(y), k1), (float8)(z), k2);
 }
 
-/* The lanes in `live` whose ray hits triangle j of block b within (tmin, tmax): block_test's
- * arithmetic (traverse8.h) for one triangle and eight rays. */
-static inline int packet_triangle(const PacketRays* p, __global const TriBlock4* b, int j,
-                                  int live) {
+/* Lane i all ones where bit i of `bits` is set. */
+static inline int8 lane_mask8(int bits) {
+  return ((int8)(bits) & (int8)(1, 2, 4, 8, 16, 32, 64, 128)) != 0;
+}
+
+/* The lanes of `live` whose ray hits triangle j of block b beyond tmin, with each lane's t and
+ * barycentrics: block_test's arithmetic (traverse8.h) for one triangle and eight rays. */
+static inline int8 packet_triangle(const PacketRays* p, __global const TriBlock4* b, int j,
+                                   int8 live, float8* t, float8* u, float8* v) {
   __global const float* v0 = (__global const float*)b->v0;
   __global const float* v1 = (__global const float*)b->v1;
   __global const float* v2 = (__global const float*)b->v2;
@@ -85,15 +92,22 @@ static inline int packet_triangle(const PacketRays* p, __global const TriBlock4*
   const float8 det = u_ + v_ + w_;
   const uint flags = ((__global const uint*)&b->flags)[j];
   const int8 cull = (flags & WP_TRI_CULL_BACKFACE) ? det < 0.0f : (int8)(0);
-  const int inside = live & lane_bits8(~mixed & (det != 0.0f) & ~cull);
-  if (inside == 0) return 0;
+  const int8 inside = live & ~mixed & (det != 0.0f) & ~cull;
+  if (!any(inside)) return (int8)(0);
   const float8 inv = 1.0f / det;
-  const float8 t = (u_ * (p->sz * az) + v_ * (p->sz * bz) + w_ * (p->sz * cz)) * inv;
-  return inside & lane_bits8((t > p->tmin) & (t < p->tmax));
+  *t = (u_ * (p->sz * az) + v_ * (p->sz * bz) + w_ * (p->sz * cz)) * inv;
+  *u = v_ * inv, *v = w_ * inv;
+  return inside & (*t > p->tmin);
 }
 
-/* The lanes in `live` that some triangle of leaf ~ref occludes. */
-static inline int packet_leaf(const SceneView* scene, const PacketRays* p, int ref, int live) {
+/* Each lane's distance of a hit at t in a leaf entered at tleaf (the reference's fmax2). */
+static inline float8 packet_distance(float8 t, float8 tleaf) {
+  return select(t, tleaf, t < tleaf);
+}
+
+/* The lanes in `live` that some triangle of leaf ~ref, entered at `tleaf`, occludes. */
+static inline int packet_leaf(const SceneView* scene, const PacketRays* p, int ref, float8 tleaf,
+                              int live) {
   const int c = ~ref;
   __global const TriBlock4* b = (__global const TriBlock4*)scene->tris + (c >> 2);
   const int blocks = (c & 3) + 1;
@@ -102,11 +116,33 @@ static inline int packet_leaf(const SceneView* scene, const PacketRays* p, int r
     __global const uint* prim = (__global const uint*)&b[i].prim;
     for (int j = 0; j < 4; ++j) {
       if (prim[j] == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
-      hit |= packet_triangle(p, b + i, j, live & ~hit);
+      float8 t, u, v;
+      const int8 in = packet_triangle(p, b + i, j, lane_mask8(live & ~hit), &t, &u, &v);
+      if (!any(in)) continue;
+      hit |= lane_bits8(in & (packet_distance(t, tleaf) < p->tmax));
       if (hit == live) return hit;
     }
   }
   return hit;
+}
+
+/* The slab test of child i of node n for the packet (traverse8_walk.def's, per ray: min and max of
+ * both planes' distances are the near and far plane's, lo <= hi): each lane's tnear, and the bits
+ * of the lanes that enter the box within (tmin, tmax). */
+static inline int packet_box(const PacketRays* p, __global const BvhNode8* n, int i, float8 tmax,
+                             float8* tnear) {
+  const float lo_x = ((__global const float*)&n->lo_x)[i],
+              hi_x = ((__global const float*)&n->hi_x)[i];
+  const float lo_y = ((__global const float*)&n->lo_y)[i],
+              hi_y = ((__global const float*)&n->hi_y)[i];
+  const float lo_z = ((__global const float*)&n->lo_z)[i],
+              hi_z = ((__global const float*)&n->hi_z)[i];
+  const float8 t0x = (lo_x - p->ox) * p->ix, t1x = (hi_x - p->ox) * p->ix;
+  const float8 t0y = (lo_y - p->oy) * p->iy, t1y = (hi_y - p->oy) * p->iy;
+  const float8 t0z = (lo_z - p->oz) * p->iz, t1z = (hi_z - p->oz) * p->iz;
+  *tnear = max8(max8(min8(t0x, t1x), min8(t0y, t1y)), max8(min8(t0z, t1z), p->tmin));
+  const float8 tfar = min8(min8(max8(t0x, t1x), max8(t0y, t1y)), min8(max8(t0z, t1z), tmax));
+  return lane_bits8(*tnear <= tfar);
 }
 
 /* The lanes of `live` whose ray is occluded: any hit in (tmin, tmax), from the root. */
@@ -116,28 +152,15 @@ static inline int packet_any_hit(const SceneView* scene, const PacketRays* p, in
   int sp = 0, node = 0, mask = live, occluded = 0;
   for (;;) {
     __global const BvhNode8* n = nodes + node;
-    __global const float* lo_x = (__global const float*)&n->lo_x;
-    __global const float* hi_x = (__global const float*)&n->hi_x;
-    __global const float* lo_y = (__global const float*)&n->lo_y;
-    __global const float* hi_y = (__global const float*)&n->hi_y;
-    __global const float* lo_z = (__global const float*)&n->lo_z;
-    __global const float* hi_z = (__global const float*)&n->hi_z;
     __global const int* cl = (__global const int*)&n->child;
     for (int i = 0; i < 8; ++i) {
       const int c = cl[i];
-      if (c == 0) continue; /* an unused slot */
-      /* The walk's slab test, per ray: min and max of both planes' distances are the near and
-       * far plane's (lo <= hi), the values traverse8_walk.def picks by the direction's sign. */
-      const float8 t0x = (lo_x[i] - p->ox) * p->ix, t1x = (hi_x[i] - p->ox) * p->ix;
-      const float8 t0y = (lo_y[i] - p->oy) * p->iy, t1y = (hi_y[i] - p->oy) * p->iy;
-      const float8 t0z = (lo_z[i] - p->oz) * p->iz, t1z = (hi_z[i] - p->oz) * p->iz;
-      const float8 tnear =
-          max8(max8(min8(t0x, t1x), min8(t0y, t1y)), max8(min8(t0z, t1z), p->tmin));
-      const float8 tfar = min8(min8(max8(t0x, t1x), max8(t0y, t1y)), min8(max8(t0z, t1z), p->tmax));
-      const int entered = mask & lane_bits8(tnear <= tfar);
+      if (c == 0) break; /* unused slots come last */
+      float8 tnear;
+      const int entered = mask & packet_box(p, n, i, p->tmax, &tnear);
       if (entered == 0) continue;
       if (c < 0) {
-        occluded |= packet_leaf(scene, p, c, entered);
+        occluded |= packet_leaf(scene, p, c, tnear, entered);
         if (occluded == live) return occluded;
         mask &= ~occluded;
       } else {
@@ -152,6 +175,108 @@ static inline int packet_any_hit(const SceneView* scene, const PacketRays* p, in
       --sp;
       mask = stack_mask[sp] & ~occluded;
       if (mask != 0) break;
+    }
+    node = stack_node[sp];
+  }
+}
+
+/* Each lane's closest hit: distance (the ray's tmax where there is none), barycentrics and scene
+ * triangle index, as traverse8_walk.def's TraceHit. */
+typedef struct PacketHit {
+  float8 t, u, v;
+  uint8 tri;
+} PacketHit;
+
+/* Leaf ~ref, entered at `tleaf` by the lanes in `live`: each lane's hit replaced by a closer one
+ * (hit_is_closer's rule, lane by lane). */
+static inline void packet_closest_leaf(const SceneView* scene, const PacketRays* p, int ref,
+                                       float8 tleaf, int live, PacketHit* h) {
+  const int c = ~ref;
+  __global const TriBlock4* b = (__global const TriBlock4*)scene->tris + (c >> 2);
+  const int blocks = (c & 3) + 1;
+  const int8 live8 = lane_mask8(live);
+  for (int i = 0; i < blocks; ++i) {
+    __global const uint* prim = (__global const uint*)&b[i].prim;
+    for (int j = 0; j < 4; ++j) {
+      const uint pj = prim[j];
+      if (pj == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
+      float8 t, u, v;
+      const int8 in = packet_triangle(p, b + i, j, live8, &t, &u, &v);
+      if (!any(in)) continue;
+      const float8 d = packet_distance(t, tleaf);
+      const int8 take = in & ((d < h->t) | ((d == h->t) & ((uint8)(pj) < h->tri)));
+      if (!any(take)) continue;
+      h->t = select(h->t, d, take);
+      h->u = select(h->u, u, take);
+      h->v = select(h->v, v, take);
+      h->tri = select(h->tri, (uint8)(pj), take);
+    }
+  }
+}
+
+/* The greatest of the lanes of `x` set in `bits` (bits != 0). */
+static inline float packet_max(float8 x, int bits) {
+  const float8 m = select((float8)(-INFINITY), x, lane_mask8(bits));
+  const float4 m4 = max(m.lo, m.hi);
+  const float2 m2 = max(m4.lo, m4.hi);
+  return max(m2.x, m2.y);
+}
+
+/* The least of the lanes of `x` set in `bits` (bits != 0). */
+static inline float packet_min(float8 x, int bits) {
+  const float8 m = select((float8)(INFINITY), x, lane_mask8(bits));
+  const float4 m4 = min(m.lo, m.hi);
+  const float2 m2 = min(m4.lo, m4.hi);
+  return min(m2.x, m2.y);
+}
+
+/* Each lane's closest hit in (tmin, tmax) for the rays in `live`, from the root: the single-ray
+ * walk's answer, which does not depend on the visiting order (hit_is_closer). The order here is
+ * the packet's: a node's children in slot order, leaves intersected at once, inner children pushed
+ * by their nearest lane's tnear, nearest on top; an entry is skipped when that tnear is beyond the
+ * farthest closest hit of its rays (a bound on each of them). */
+static inline void packet_closest(const SceneView* scene, const PacketRays* p, int live,
+                                  PacketHit* h) {
+  __global const BvhNode8* nodes = (__global const BvhNode8*)scene->nodes;
+  int stack_node[WP_BVH8_STACK_SIZE], stack_mask[WP_BVH8_STACK_SIZE];
+  float stack_t[WP_BVH8_STACK_SIZE];
+  h->t = p->tmax;
+  h->u = h->v = (float8)(0.0f);
+  h->tri = (uint8)(0u); /* hit_is_closer: no tie with "no hit" */
+  int sp = 0, node = 0, mask = live;
+  for (;;) {
+    __global const BvhNode8* n = nodes + node;
+    __global const int* cl = (__global const int*)&n->child;
+    const int base = sp;
+    for (int i = 0; i < 8; ++i) {
+      const int c = cl[i];
+      if (c == 0) break; /* unused slots come last */
+      float8 tnear;
+      const int entered = mask & packet_box(p, n, i, h->t, &tnear);
+      if (entered == 0) continue;
+      if (c < 0) {
+        packet_closest_leaf(scene, p, c, tnear, entered, h);
+        continue;
+      }
+      /* Pushed in decreasing order of the nearest lane's tnear (insertion, as the walk's). */
+      const float t = packet_min(tnear, entered);
+      int e = sp++;
+      while (e > base && stack_t[e - 1] <= t) {
+        stack_t[e] = stack_t[e - 1];
+        stack_node[e] = stack_node[e - 1];
+        stack_mask[e] = stack_mask[e - 1];
+        --e;
+      }
+      stack_t[e] = t;
+      stack_node[e] = c;
+      stack_mask[e] = entered;
+    }
+    /* Next: the top entry that can still hold something closer for one of its rays. */
+    for (;;) {
+      if (sp == 0) return;
+      --sp;
+      mask = stack_mask[sp];
+      if (!(stack_t[sp] > packet_max(h->t, mask))) break;
     }
     node = stack_node[sp];
   }

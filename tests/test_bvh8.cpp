@@ -13,7 +13,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh/build_tree.h"  // internal: flatten_wide on hand-made trees
+#include "bvh/build_tree.h"       // internal: flatten_wide on hand-made trees
+#include "bvh/traverse_common.h"  // internal: the slab and triangle tests, for the definition
 #include "bvh/bvh.h"
 #include "host/util/error.h"
 #include "tests/bvh_test_util.h"
@@ -314,8 +315,8 @@ TEST(Bvh8Build, OversizedLeavesBecomeSubtrees) {
   EXPECT_EQ(single.stats.triangle_refs, 1000u);
 }
 
-// Two identical triangles (0 and 1) in the plane z = 0, under different children: the one
-// visited first is the hit (a later one replaces it only if strictly closer). Triangles 2 and 3,
+// Two identical triangles (0 and 1) in the plane z = 0, under different children: a tie, which
+// the lower index wins whatever the order of the visits (traverse_common.h). Triangles 2 and 3,
 // in the same plane but away from the test ray, give inner children their second leaf. The root
 // box reaches up to z = 2, so that a ray down from z = 1 starts inside it.
 Mesh twin_triangles() {
@@ -328,22 +329,24 @@ Mesh twin_triangles() {
 const detail::Box kTwinScene{{0, 0, 0}, {6, 6, 2}};
 const Ray kDown{{0.25f, 0.25f, 1}, {0, 0, -1}};  // meets the twins at t = 1
 
-TEST(Bvh8Traverse, LeavesOfOneNodeAreTestedInLaneOrder) {
+// Leaves of one node, in either lane order, entered nearer or farther: triangle 0.
+TEST(Bvh8Traverse, LeavesOfOneNodeTieToTheLowerTriangleIndex) {
   const Mesh m = twin_triangles();
   HandTree t;
   const detail::TreeLeaf& a = t.leaf(m, {0});
   const detail::TreeLeaf& b = t.leaf(m, {1});
   const detail::TreeLeaf& far = t.leaf(m, {2, 3});
-  // The box of b is entered first (t = 0.5, a's at t = 1): leaves go by lane all the same.
+  // The box of b is entered first (t = 0.5, a's at t = 1).
   const detail::Box a_box{{0, 0, 0}, {1, 1, 0}}, b_box{{0, 0, 0}, {1, 1, 0.5f}};
   const Bvh ab = flatten(m, t.inner({&a, &b, &far}, {a_box, b_box, far.bounds}), kTwinScene);
   const Bvh ba = flatten(m, t.inner({&b, &a, &far}, {b_box, a_box, far.bounds}), kTwinScene);
   EXPECT_EQ(check_invariants(ab, 4, false), "");
   EXPECT_EQ(intersect_closest(ab, kDown).triangle, 0u);
-  EXPECT_EQ(intersect_closest(ba, kDown).triangle, 1u);
+  EXPECT_EQ(intersect_closest(ba, kDown).triangle, 0u);
 }
 
-TEST(Bvh8Traverse, InnerChildrenAreVisitedNearestFirstTiesToTheLowerLane) {
+// Inner children in either lane order, either one's box entered first: triangle 0.
+TEST(Bvh8Traverse, InnerChildrenTieToTheLowerTriangleIndex) {
   const Mesh m = twin_triangles();
   HandTree t;
   // Inner children A (triangle 0 and 2) and B (triangle 1 and 3).
@@ -362,10 +365,147 @@ TEST(Bvh8Traverse, InnerChildrenAreVisitedNearestFirstTiesToTheLowerLane) {
     EXPECT_EQ(check_invariants(bvh, 4, false), "");
     return intersect_closest(bvh, kDown).triangle;
   };
-  EXPECT_EQ(first_hit(a, nearer, b, nearer), 0u);  // a tie: the lower lane first
-  EXPECT_EQ(first_hit(b, nearer, a, nearer), 1u);
-  EXPECT_EQ(first_hit(a, farther, b, nearer), 1u);  // the nearer entry first, whatever its lane
+  EXPECT_EQ(first_hit(a, nearer, b, nearer), 0u);
+  EXPECT_EQ(first_hit(b, nearer, a, nearer), 0u);
+  EXPECT_EQ(first_hit(a, farther, b, nearer), 0u);
   EXPECT_EQ(first_hit(b, farther, a, nearer), 0u);
+}
+
+// The closest hit by its definition (traverse_common.h), with no walk: every leaf whose boxes,
+// root to leaf, the ray enters within (tmin, tmax), every triangle in them at distance max(t, the
+// leaf's tnear), the least (distance, triangle index); the leaves taken in slot order or reversed.
+struct Definition {
+  const Bvh& bvh;
+  detail::PreparedRay r;
+  float tmax;
+  bool reversed;
+  Hit best{};
+  float best_t;
+  float at = kInf;           // count the candidates at this distance ...
+  std::size_t at_count = 0;  // ... here
+
+  Definition(const Bvh& b, const Ray& ray, bool rev)
+      : bvh(b), r(ray), tmax(ray.tmax), reversed(rev), best_t(ray.tmax) {}
+  void triangle(const detail::TriangleData& tri, float tleaf) {
+    Hit alone;
+    if (detail::triangle_test(r, tri, tleaf, tmax, alone) && alone.t == at) ++at_count;
+    if (detail::triangle_test(r, tri, tleaf, best_t, best)) best_t = best.t;
+  }
+  void wide(std::int32_t node) {
+    const dev::BvhNode8& n = bvh.nodes8[std::size_t(node)];
+    for (int k = 0; k < WP_BVH8_WIDTH; ++k) {
+      const int i = reversed ? WP_BVH8_WIDTH - 1 - k : k;
+      const std::int32_t child = n.child.s[i];
+      float tnear;
+      if (child == 0 || !detail::slab_test(r, n.lo_x.s[i], n.hi_x.s[i], n.lo_y.s[i], n.hi_y.s[i],
+                                           n.lo_z.s[i], n.hi_z.s[i], tmax, tnear))
+        continue;
+      if (child > 0) {
+        wide(child);
+        continue;
+      }
+      const std::size_t first = std::size_t(~child >> 2), blocks = std::size_t(~child & 3) + 1;
+      for (std::size_t b = first; b < first + blocks; ++b)
+        for (int lane = 0; lane < 4; ++lane) {
+          const dev::TriBlock4& tb = bvh.blocks[b];
+          const auto of = [lane](const auto& v) {
+            return lane == 0 ? v.x : lane == 1 ? v.y : lane == 2 ? v.z : v.w;
+          };
+          detail::TriangleData tri{};
+          for (int a = 0; a < 3; ++a) {
+            tri.v[0][a] = of(tb.v0[a]), tri.v[1][a] = of(tb.v1[a]), tri.v[2][a] = of(tb.v2[a]);
+          }
+          tri.flags = of(tb.flags), tri.prim = of(tb.prim);
+          triangle(tri, tnear);
+        }
+    }
+  }
+};
+
+Hit closest_by_definition(const Bvh& bvh, const Ray& ray, bool reversed) {
+  Definition d(bvh, ray, reversed);
+  if (!bvh.nodes8.empty()) d.wide(0);
+  return d.best;
+}
+
+// How many candidates (triangle references) the definition finds at distance `t`.
+std::size_t candidates_at(const Bvh& bvh, const Ray& ray, float t) {
+  Definition d(bvh, ray, false);
+  d.at = t;
+  if (!bvh.nodes8.empty()) d.wide(0);
+  return d.at_count;
+}
+
+bool same_hit(const Hit& a, const Hit& b) {
+  return a.hit == b.hit && bits(a.t) == bits(b.t) && bits(a.u) == bits(b.u) &&
+         bits(a.v) == bits(b.v) && a.triangle == b.triangle;
+}
+
+// The walk (nearest child first, culling by the closest hit so far) gives every ray the hit the
+// definition gives, in either order of the leaves: so any order does (what packets of rays rely
+// on, kernels/traverse8_packet.h). Rays aimed at the vertices and edge midpoints of a grid, flat
+// (its leaf boxes flat too, so that a hit's t and its leaf's tnear are two roundings of one
+// distance) and curved, where several triangles tie; random rays besides. Both kinds of case
+// occur and are counted: ties, and hits whose leaf's tnear exceeds the triangle's own t, where
+// the distance is that tnear, checked to lie within 4 ulps (tnear's three roundings and one for
+// the double-precision distance) of the exact distance computed in double.
+TEST(Bvh8Traverse, ClosestHitIsTheDefinitionsInAnyOrder) {
+  std::size_t ties = 0, raised = 0, rays_total = 0;
+  for (const bool flat : {true, false}) {
+    Mesh m = grid(24);
+    if (flat)
+      for (glm::vec3& p : m.positions) p.z = 0.0f;
+    for (const int leaf : {1, 4, 16}) {
+      const Bvh bvh = build(m.input(), wide(leaf));
+      std::vector<Ray> rays = make_rays(bvh, 2000, 2000, unsigned(leaf));
+      std::mt19937 rng(unsigned(leaf) + 100u);
+      std::uniform_real_distribution<float> u(-1, 1);
+      for (std::size_t i = 0; i < m.positions.size(); ++i) {
+        const glm::vec3 v = m.positions[i];
+        const glm::vec3 next = m.positions[(i + 1) % m.positions.size()];
+        for (const glm::vec3 target : {v, 0.5f * (v + next)}) {
+          const glm::vec3 eye(0.5f + 0.4f * u(rng), 0.5f + 0.4f * u(rng), 1.0f + 0.5f * u(rng));
+          rays.push_back({eye, target - eye, 0.0f, kInf});
+        }
+      }
+      for (const Ray& ray : rays) {
+        const Hit walk = intersect_closest(bvh, ray);
+        const Hit forward = closest_by_definition(bvh, ray, false);
+        const Hit backward = closest_by_definition(bvh, ray, true);
+        ASSERT_TRUE(same_hit(walk, forward) && same_hit(walk, backward))
+            << "walk " << walk.triangle << " t " << walk.t << ", definition " << forward.triangle
+            << " / " << backward.triangle << " t " << forward.t << " / " << backward.t;
+        EXPECT_EQ(occluded(bvh, ray), walk.hit);
+        ++rays_total;
+        if (!walk.hit) continue;
+        // The triangle alone (no leaf): its own t; another triangle at the walk's distance.
+        Hit alone;
+        const std::size_t tri = walk.triangle;
+        const dev::IsectTri it{
+            {m.positions[m.indices[3 * tri]].x, m.positions[m.indices[3 * tri]].y,
+             m.positions[m.indices[3 * tri]].z, as_float(std::uint32_t(tri))},
+            {m.positions[m.indices[3 * tri + 1]].x, m.positions[m.indices[3 * tri + 1]].y,
+             m.positions[m.indices[3 * tri + 1]].z, as_float(0u)},
+            {m.positions[m.indices[3 * tri + 2]].x, m.positions[m.indices[3 * tri + 2]].y,
+             m.positions[m.indices[3 * tri + 2]].z, 0.0f}};
+        ASSERT_TRUE(intersect_triangle(it, ray, kInf, alone));
+        ASSERT_LE(alone.t, walk.t);
+        if (alone.t < walk.t) {
+          ++raised;
+          const glm::dvec3 o(ray.o), d(ray.d), a(m.positions[m.indices[3 * tri]]);
+          const glm::dvec3 n = glm::cross(glm::dvec3(m.positions[m.indices[3 * tri + 1]]) - a,
+                                          glm::dvec3(m.positions[m.indices[3 * tri + 2]]) - a);
+          const double exact = glm::dot(n, a - o) / glm::dot(n, d);
+          EXPECT_LE(double(walk.t), exact * (1.0 + 4.0 * 0x1p-24));
+        }
+        ties += candidates_at(bvh, ray, walk.t) > 1;
+      }
+    }
+  }
+  std::printf("%zu rays, %zu ties, %zu hits at their leaf's tnear\n", rays_total, ties, raised);
+  EXPECT_GT(ties, 100u);
+  EXPECT_GT(raised, 10u);
+  EXPECT_GT(rays_total, 20000u);
 }
 
 // ---------------------------------------------------------------------------------------------

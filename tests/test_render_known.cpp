@@ -572,20 +572,24 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
     st.seed = 11;
     const wp::Rendered first = wp::render(*runtime_, s, st);
     const auto& reference = first.image.rgb;
-    // The scene's shadow rays are plain any-hit queries, so on PoCL's CPU devices (the wide BVH)
-    // the default traces them in packets: the comparisons below do test both traversals.
+    // The scene has no instances, alpha or transmission, so on PoCL's CPU devices (the wide BVH)
+    // the default traces shadow rays and closest-hit rays in packets: the comparisons below do
+    // test both traversals. (Closest-hit rays take turns of packets and single rays per bounce
+    // until one is found faster, Wavefront::packet_mode: a render of several waves uses both.)
     const wp::DeviceEntry& device = runtime_->device();
     if (!device.gpu && device.platform_name == "Portable Computing Language") {
       EXPECT_NE(first.report.build_options.find("-D WP_SHADOW_PACKET=1"), std::string::npos)
+          << first.report.build_options;
+      EXPECT_NE(first.report.build_options.find("-D WP_CLOSEST_PACKET=1"), std::string::npos)
           << first.report.build_options;
     }
     double sum = 0.0;
     for (float v : reference) sum += v;
     EXPECT_GT(sum, 0.0);
     // ... and with the cache hints off (prefetch false; on PoCL they are on by default), and with
-    // each shadow ray traced on its own (on PoCL's CPU devices they go eight to a work-item by
-    // default, kernels/traverse8_packet.h, and the wave and group sizes change which rays share a
-    // packet).
+    // each shadow and closest-hit ray traced on its own (on PoCL's CPU devices they go eight to a
+    // work-item by default, kernels/traverse8_packet.h, and the wave and group sizes change which
+    // rays share a packet).
     for (const auto& [wave, local, prefetch, packets] :
          std::vector<std::tuple<std::size_t, std::size_t, bool, bool>>{{0, 0, true, true},
                                                                        {1000, 0, true, true},
@@ -601,14 +605,14 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
       st.wave_size = wave;
       st.local_size = local;
       st.prefetch = prefetch;
-      st.shadow_packets = packets;
+      st.shadow_packets = st.closest_packets = packets;
       const auto image = wp::render(*runtime_, s, st).image.rgb;
       ASSERT_EQ(image.size(), reference.size());
       EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))
           << "wave " << wave << " local " << local << " prefetch " << prefetch << " packets "
           << packets;
     }
-    st.shadow_packets = true;
+    st.shadow_packets = st.closest_packets = true;
     st.wave_size = 0;
     st.local_size = 0;
     st.prefetch = true;

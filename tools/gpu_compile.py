@@ -101,9 +101,11 @@ def wavepath_options(wavepath, scene, features):
     if run.returncode != 0:
         fail(f"wavepath failed on {scene['path']}:\n{run.stderr}")
     report = json.loads(run.stdout.strip().splitlines()[-1])
-    # The host adds the cache hints (WP_PREFETCH) and shadow-ray packets (WP_SHADOW_PACKET) for
-    # PoCL's CPU devices only: a GPU's build has neither, so neither do these.
-    options = re.sub(r" -D WP_(PREFETCH|SHADOW_PACKET)=\d+", "", report["build_options"])
+    # The host adds the cache hints (WP_PREFETCH) and ray packets (WP_SHADOW_PACKET,
+    # WP_CLOSEST_PACKET) for PoCL's CPU devices only: a GPU's build has none, so neither do these.
+    options = re.sub(
+        r" -D WP_(PREFETCH|SHADOW_PACKET|CLOSEST_PACKET)=\d+", "", report["build_options"]
+    )
     return options, report["features"]
 
 

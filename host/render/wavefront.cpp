@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 
 #include "host/device/device_scene.h"
 #include "host/util/error.h"
@@ -130,14 +129,15 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   const bool pocl_cpu = !device.gpu && device.platform_name == "Portable Computing Language";
   const bool prefetch = settings.prefetch && pocl_cpu;
   options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
-  // Shadow rays eight to a work-item (kernels/traverse8_packet.h) where they are plain any-hit
-  // queries on the wide layout; only on PoCL's CPU devices, where it was measured
-  // (docs/performance.md, "Shadow rays in packets of eight"). The same image either way.
-  shadow_packet_ = settings.shadow_packets && pocl_cpu && bvh.width == 8 && !features_.instances &&
-                           !features_.alpha && !features_.transmission
-                       ? 8u
-                       : 1u;
+  // Rays eight to a work-item (kernels/traverse8_packet.h) on the wide layout without instances
+  // or alpha: shadow rays where they are plain any-hit queries (no transmission), closest-hit
+  // rays always there. Only on PoCL's CPU devices, where it was measured (docs/performance.md,
+  // "Shadow rays in packets of eight", "Closest-hit rays in packets"). The same image either way.
+  const bool packets = pocl_cpu && bvh.width == 8 && !features_.instances && !features_.alpha;
+  shadow_packet_ = settings.shadow_packets && packets && !features_.transmission ? 8u : 1u;
+  closest_packet_ = settings.closest_packets && packets ? 8u : 1u;
   if (shadow_packet_ > 1) options_ += " -D WP_SHADOW_PACKET=1";
+  if (closest_packet_ > 1) options_ += " -D WP_CLOSEST_PACKET=1";
   memory_ = state_memory(settings, features_);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
@@ -269,6 +269,8 @@ void Wavefront::prime_kernels() {
 cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
   if (items == 0) return cl::Event();
   if (stage == Stage::kTraceShadow) items = (items + shadow_packet_ - 1) / shadow_packet_;
+  if (stage == Stage::kIntersectClosest && closest_packet_ > 1 && params.packet > 1)
+    items = (items + closest_packet_ - 1) / closest_packet_;
   const std::size_t local = local_size_;
   const std::size_t global = local ? (items + local - 1) / local * local : items;
   cl::Kernel& k = kernel(stage);
@@ -281,6 +283,7 @@ cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch&
     rethrow_cl(e, std::string("launching ") + stage_name(stage));
   }
   if (settings_.profile) pending_events_.emplace_back(stage, event);
+  if (stage == Stage::kIntersectClosest) last_intersect_ = event;
   return event;
 }
 
@@ -315,17 +318,67 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   p.max_depth = static_cast<dev::uint>(settings_.max_depth);
   p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
   p.rr_threshold = settings_.rr_threshold;
+  // Closest-hit packets where the program has them; run_wave picks per bounce.
+  p.packet = closest_packet_;
   return p;
+}
+
+// Closest-hit packets (kernels/traverse8_packet.h) pay where a packet's rays share much of their
+// walk (a small scene, coherent camera rays) and cost where they part (rays past the edges of
+// objects toward the sky, glossy bounces: docs/performance.md, "Closest-hit rays in packets"),
+// and no rule on the scene alone predicts which. So each bounce index takes turns of packets and
+// single rays until each has traced kPacketTimingRays rays or been launched kPacketTimingLaunches
+// times (deep bounces trace few rays), then keeps the faster per ray; the first wave, slower for
+// a cold start whichever it uses, is not timed. The image does not depend
+// on the choice (the walks give every ray the same hit), only the time.
+constexpr std::uint64_t kPacketTimingRays = 1u << 17;
+constexpr int kPacketTimingLaunches = 2;
+constexpr std::size_t kPacketTimingBounces = 8;  // deeper bounces share the last one's choice
+
+int Wavefront::packet_mode(std::size_t bounce) const {
+  if (closest_packet_ <= 1) return 0;
+  const std::size_t b = std::min(bounce, kPacketTimingBounces - 1);
+  if (b >= packet_timing_.size()) return 0;
+  const PacketTiming& t = packet_timing_[b];
+  if (t.choice >= 0) return t.choice;
+  return t.launches[1] < t.launches[0] ? 1 : 0;
+}
+
+void Wavefront::time_packets(std::size_t bounce, int mode, std::uint32_t rays) {
+  if (closest_packet_ <= 1 || rays == 0 || waves_run_ == 0 || last_intersect_() == nullptr) return;
+  const std::size_t b = std::min(bounce, kPacketTimingBounces - 1);
+  if (packet_timing_.size() <= b) packet_timing_.resize(b + 1);
+  PacketTiming& t = packet_timing_[b];
+  if (t.choice >= 0) return;
+  const auto start = last_intersect_.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  const auto end = last_intersect_.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  t.seconds[mode] += static_cast<double>(end - start) * 1e-9;
+  t.rays[mode] += rays;
+  t.launches[mode] += 1;
+  const auto timed = [&t](int m) {
+    return t.rays[m] >= kPacketTimingRays || t.launches[m] >= kPacketTimingLaunches;
+  };
+  if (timed(0) && timed(1))
+    t.choice = t.seconds[1] / static_cast<double>(t.rays[1]) <
+                       t.seconds[0] / static_cast<double>(t.rays[0])
+                   ? 1
+                   : 0;
 }
 
 // One wave of paths through all bounces: the pipeline's start, bounces until no ray is left, end.
 void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
                          std::uint32_t samples) {
   dev::Launch p = start_wave(sample, first_pixel, count, samples);
-  for (std::uint32_t rays = p.path_count; rays > 0;) {
+  std::size_t bounce = 0;
+  for (std::uint32_t rays = p.path_count; rays > 0; ++bounce) {
     rays_traced_ += rays;
+    const int mode = packet_mode(bounce);
+    p.packet = mode == 1 ? closest_packet_ : 1u;
+    const std::uint32_t traced = rays;
     rays = run_bounce(p, rays);
+    time_packets(bounce, mode, traced);
   }
+  ++waves_run_;
   run_step(pipeline_.end, p, 0);
 }
 

@@ -87,6 +87,9 @@ struct RenderSettings {
   // Shadow rays traced eight to a work-item where they are plain any-hit queries, on PoCL's CPU
   // devices with the wide BVH (kernels/traverse8_packet.h); elsewhere one each. The same image.
   bool shadow_packets = true;
+  // Closest-hit rays likewise, where the program has no instances or alpha (the same walk's
+  // closest-hit form: the answer does not depend on which rays share a packet).
+  bool closest_packets = true;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Where built kernel programs are cached (host/device/program_cache.h; the command line passes
   // bvh::cache_dir()); empty: nothing is cached.
@@ -266,7 +269,21 @@ class Wavefront {
   std::size_t wave_size_ = 0;
   std::size_t samples_per_wave_ = 1;
   std::size_t local_size_ = 0;
-  std::uint32_t shadow_packet_ = 1;  // shadow rays per work-item (kernels/traverse8_packet.h)
+  std::uint32_t shadow_packet_ = 1;   // shadow rays per work-item (kernels/traverse8_packet.h)
+  std::uint32_t closest_packet_ = 1;  // closest-hit rays per work-item where a bounce uses packets
+  // Whether each bounce's closest-hit rays go in packets (closest_packet_ > 1 only): the faster
+  // per ray of the two, timed on the first waves (run_wave). The same image either way.
+  struct PacketTiming {
+    double seconds[2] = {0.0, 0.0};  // intersect_closest's time [single, packets] ...
+    std::uint64_t rays[2] = {0, 0};  // ... over these many rays
+    int launches[2] = {0, 0};        // ... in these many launches
+    int choice = -1;                 // 0 single, 1 packets, -1 still timing
+  };
+  std::vector<PacketTiming> packet_timing_;
+  int packet_mode(std::size_t bounce) const;
+  void time_packets(std::size_t bounce, int mode, std::uint32_t rays);
+  cl::Event last_intersect_;   // the latest intersect_closest launch, for time_packets
+  std::size_t waves_run_ = 0;  // run_wave's count: the first wave (a cold start) is not timed
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;
   bool kernel_cached_ = false;

@@ -26,4 +26,46 @@ WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch laun
   }
 }
 
+#if WP_CLOSEST_PACKET
+#if WP_BVH_WIDTH != 8 || WP_BVH_INSTANCES || WP_FEATURE_ALPHA
+#error "WP_CLOSEST_PACKET: the wide layout without instances or alpha only (traverse8_packet.h)"
+#endif
+
+/* The rays of entries [first, first + WP_PACKET) of `queue` as one packet: the same hit records
+ * as intersect_path gives each (traverse8_packet.h). */
+WP_STAGE_FN void intersect_packet(const SceneView* scene, Paths paths, Queues queues, uint queue,
+                                  uint first) {
+  TraceRay r[WP_PACKET];
+  float tmax[WP_PACKET];
+  uint slots[WP_PACKET];
+  /* The single-ray stage's cache hints, for the entries WP_PREFETCH_AHEAD further on. */
+  for (uint i = 0u; i < WP_PACKET; ++i) {
+    uint ahead;
+    if (prefetch_slot(queues, queue, first + i, &ahead)) intersect_prefetch(paths, ahead);
+  }
+  const int n = queue_get_run(queues, queue, first, WP_PACKET, slots);
+  if (n == 0) return;
+  for (int i = 0; i < n; ++i) {
+    r[i] = trace_ray(path_ray_origin(paths, slots[i]), path_ray_dir(paths, slots[i]),
+                     path_ray_tmin(paths, slots[i]), 0u);
+    tmax[i] = INFINITY;
+  }
+  const PacketRays p = packet_rays(r, tmax, n);
+  PacketHit h;
+  packet_closest(scene, &p, (1 << n) - 1, &h);
+  float t[WP_PACKET], u[WP_PACKET], v[WP_PACKET];
+  uint tri[WP_PACKET];
+  vstore8(h.t, 0, t);
+  vstore8(h.u, 0, u);
+  vstore8(h.v, 0, v);
+  vstore8(h.tri, 0, tri);
+  for (int i = 0; i < n; ++i) {
+    if (t[i] < INFINITY)
+      path_store_hit(paths, slots[i], t[i], u[i], v[i], tri[i]);
+    else
+      path_store_hit(paths, slots[i], INFINITY, 0.0f, 0.0f, 0u);
+  }
+}
+#endif
+
 #endif /* WP_INTEGRATOR_INTERSECT_CLOSEST_H */

@@ -74,7 +74,6 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
 #if WP_BVH_WIDTH != 8 || WP_BVH_INSTANCES || WP_FEATURE_ALPHA || WP_FEATURE_TRANSMISSION
 #error "WP_SHADOW_PACKET: plain any-hit queries on the wide layout only (traverse8_packet.h)"
 #endif
-#include "traverse8_packet.h"
 
 /* The shadow rays of queue entries [first, first + WP_PACKET) as one packet: the same answers as
  * trace_shadow_path gives each (traverse8_packet.h). */
@@ -89,14 +88,13 @@ WP_STAGE_FN void trace_shadow_packet(const SceneView* scene, Paths paths, Queues
     if (prefetch_slot(queues, WP_QUEUE_SHADOW, first + i, &ahead))
       trace_shadow_prefetch(paths, ahead);
   }
-  int n = 0;
-  for (; n < WP_PACKET; ++n) {
-    if (!queue_get(queues, WP_QUEUE_SHADOW, first + (uint)n, &slots[n])) break;
-    r[n] =
-        trace_ray(path_shadow_origin(paths, slots[n]), path_shadow_dir(paths, slots[n]), 0.0f, 0u);
-    tmax[n] = path_shadow_tmax(paths, slots[n]);
-  }
+  const int n = queue_get_run(queues, WP_QUEUE_SHADOW, first, WP_PACKET, slots);
   if (n == 0) return;
+  for (int i = 0; i < n; ++i) {
+    r[i] =
+        trace_ray(path_shadow_origin(paths, slots[i]), path_shadow_dir(paths, slots[i]), 0.0f, 0u);
+    tmax[i] = path_shadow_tmax(paths, slots[i]);
+  }
   const PacketRays p = packet_rays(r, tmax, n);
   const int live = (1 << n) - 1;
   const int occluded = packet_any_hit(scene, &p, live);

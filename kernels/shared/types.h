@@ -201,7 +201,9 @@ typedef struct Launch {
   uint wave_pixels; /* pixels in this wave: path slot i renders pixel pixel_offset + i % wave_pixels
                        at sample index sample + i / wave_pixels (stage.h, path_sample) */
   float rr_threshold; /* roulette ends paths whose throughput is below this (roulette_compact.h) */
-  uint pad[4];        /* to 64 bytes, a multiple of 16 on every device */
+  uint packet;        /* intersect_closest's rays per work-item: 1, or WP_PACKET where the program
+                         has WP_CLOSEST_PACKET (traverse8_packet.h) */
+  uint pad[3];        /* to 64 bytes, a multiple of 16 on every device */
 } Launch;
 
 WP_DEV_END

@@ -224,6 +224,8 @@ class Stages : public ::testing::Test {
     capture();
   }
   static void TearDownTestSuite() {
+    delete single_wf_;
+    single_wf_ = nullptr;
     delete other_wf_;
     delete other_bvh_;
     other_wf_ = nullptr;
@@ -298,10 +300,13 @@ class Stages : public ::testing::Test {
 
   // The two traversal stages run on both BVH layouts: the device's (wf_, bvh_) and the other one
   // (binary on a CPU device, 8-wide on a GPU), a Wavefront of the same scene and settings made on
-  // first use, whose path state has the same layout, so that it takes the same captured states.
+  // first use, whose path state has the same layout, so that it takes the same captured states;
+  // where the device's program traces rays in packets (kernels/traverse8_packet.h), once more on
+  // its layout with one ray per work-item.
   struct Traversal {
     wp::Wavefront* wf;
     const wp::bvh::Bvh* bvh;
+    std::string name;
   };
   static std::vector<Traversal> traversals() {
     if (!other_wf_) {
@@ -309,8 +314,20 @@ class Stages : public ::testing::Test {
       options.width = bvh_->width == 8 ? 2 : 8;
       other_bvh_ = new wp::bvh::Bvh(wp::bvh::build(wp::bvh_input(*scene_, tri_flags_), options));
       other_wf_ = new wp::Wavefront(*runtime_, *scene_, *other_bvh_, *settings_);
+      if (wf_->build_options().find("_PACKET=1") != std::string::npos) {
+        wp::RenderSettings single = *settings_;
+        single.shadow_packets = single.closest_packets = false;
+        single_wf_ = new wp::Wavefront(*runtime_, *scene_, *bvh_, single);
+      }
     }
-    return {{wf_, bvh_}, {other_wf_, other_bvh_}};
+    const auto name = [](const wp::bvh::Bvh* b, const wp::Wavefront* w) {
+      return "BVH width " + std::to_string(b->width) +
+             (w->build_options().find("_PACKET=1") != std::string::npos ? " (packets)" : "");
+    };
+    std::vector<Traversal> out = {{wf_, bvh_, name(bvh_, wf_)},
+                                  {other_wf_, other_bvh_, name(other_bvh_, other_wf_)}};
+    if (single_wf_) out.push_back({single_wf_, bvh_, name(bvh_, single_wf_)});
+    return out;
   }
 
   // Fails for every field not in `may_change` that differs (bitwise) between the two states in
@@ -416,6 +433,7 @@ class Stages : public ::testing::Test {
   inline static wp::Wavefront* wf_ = nullptr;
   inline static wp::bvh::Bvh* other_bvh_ = nullptr;
   inline static wp::Wavefront* other_wf_ = nullptr;
+  inline static wp::Wavefront* single_wf_ = nullptr;  // the device's layout, no packets
   inline static std::vector<Bounce> bounces_;
   inline static wp::Wavefront::Snapshot
       end_;  // the wave after its last bounce: what accumulate reads

@@ -115,7 +115,7 @@ TEST_F(Stages, IntersectClosestMatchesTheCpuTraversal) {
     for (int k = 0; k <= kBounces; ++k) {
       const bool window = k == kBounces;
       const int b = window ? 0 : k;
-      SCOPED_TRACE("BVH width " + std::to_string(tr.bvh->width) + ", bounce " + std::to_string(b) +
+      SCOPED_TRACE(tr.name + ", bounce " + std::to_string(b) +
                    (window ? ", rays with tmin set" : ""));
       const Bounce& c = bounces_[b];
       tr.wf->restore(c.start);  // the bounce's rays, as intersect_closest finds them
@@ -182,7 +182,7 @@ TEST_F(Stages, TraceShadowAddsUnoccludedContributions) {
     input(Stage::kTraceShadow, b);
     const wp::Wavefront::Snapshot shadow_rays = wf_->snapshot();
     for (const Traversal& tr : traversals()) {
-      SCOPED_TRACE("BVH width " + std::to_string(tr.bvh->width) + ", bounce " + std::to_string(b));
+      SCOPED_TRACE(tr.name + ", bounce " + std::to_string(b));
       tr.wf->restore(shadow_rays);
       const PathView before = view(*tr.wf);
       launch(Stage::kTraceShadow, c, c.params, *tr.wf);
