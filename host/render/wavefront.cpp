@@ -329,8 +329,8 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
 // and no rule on the scene alone predicts which. So each bounce index takes turns of packets and
 // single rays until each has traced kPacketTimingRays rays or been launched kPacketTimingLaunches
 // times (deep bounces trace few rays), then keeps the faster per ray; the first wave, slower for
-// a cold start whichever it uses, is not timed. The image does not depend
-// on the choice (the walks give every ray the same hit), only the time.
+// a cold start whichever it uses, is not timed. The image does not depend on the choice (the
+// walks give every ray the same hit), only the time.
 constexpr std::uint64_t kPacketTimingRays = 1u << 17;
 constexpr int kPacketTimingLaunches = 2;
 constexpr std::size_t kPacketTimingBounces = 8;  // deeper bounces share the last one's choice
