@@ -73,11 +73,12 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
   const float4 tm = select((float4)(INFINITY), d, ok);
   const float2 m2 = fmin(tm.lo, tm.hi);
   const float m = fmin(m2.x, m2.y);
-  /* Lanes left out hold INFINITY, and m <= hit->t < INFINITY; the lowest index among them. */
-  const uint4 pm = select((uint4)(0xffffffffu), prim, ok & (tm == m));
+  /* m is the least d of the lanes in ok; the lowest index among the lanes at m. */
+  const int4 nearest = ok & (tm == m);
+  const uint4 pm = select((uint4)(0xffffffffu), prim, nearest);
   const uint2 p2 = min(pm.lo, pm.hi);
   const uint p = min(p2.x, p2.y);
-  const int4 at = ok & (tm == m) & (prim == p);
+  const int4 at = nearest & (prim == p);
   const int lane = at.x ? 0 : at.y ? 1 : at.z ? 2 : 3;
   float ul[4], vl[4];
   vstore4(u, 0, ul);

@@ -59,12 +59,9 @@ WP_STAGE_FN void intersect_packet(const SceneView* scene, Paths paths, Queues qu
   vstore8(h.u, 0, u);
   vstore8(h.v, 0, v);
   vstore8(h.tri, 0, tri);
-  for (int i = 0; i < n; ++i) {
-    if (t[i] < INFINITY)
-      path_store_hit(paths, slots[i], t[i], u[i], v[i], tri[i]);
-    else
-      path_store_hit(paths, slots[i], INFINITY, 0.0f, 0.0f, 0u);
-  }
+  /* A lane that hit nothing still holds packet_closest's start, intersect_path's miss record
+   * (t = tmax = INFINITY, u = v = 0, triangle 0). */
+  for (int i = 0; i < n; ++i) path_store_hit(paths, slots[i], t[i], u[i], v[i], tri[i]);
 }
 #endif
 
