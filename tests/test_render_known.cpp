@@ -606,7 +606,19 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
       st.local_size = local;
       st.prefetch = prefetch;
       st.shadow_packets = st.closest_packets = packets;
-      const auto image = wp::render(*runtime_, s, st).image.rgb;
+      const wp::Rendered rendered = wp::render(*runtime_, s, st);
+      const auto& image = rendered.image.rgb;
+      if (!packets) {
+        EXPECT_EQ(rendered.report.closest_packet, 1u);
+        EXPECT_TRUE(rendered.report.closest_packets.empty());
+      } else if (rendered.report.closest_packet > 1 && wave == 1000) {
+        // Several waves (the image has more pixels x samples than 1000): the camera rays of the
+        // waves after the first were timed both ways, and the report says so.
+        ASSERT_FALSE(rendered.report.closest_packets.empty());
+        const wp::PacketTiming& camera = rendered.report.closest_packets[0];
+        EXPECT_GT(camera.rays[0], 0u);
+        EXPECT_GT(camera.rays[1], 0u);
+      }
       ASSERT_EQ(image.size(), reference.size());
       EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))
           << "wave " << wave << " local " << local << " prefetch " << prefetch << " packets "

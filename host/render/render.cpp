@@ -441,6 +441,8 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
   r.nonfinite_samples = passes.nonfinite();
   r.rays = wavefront.rays_traced();
   r.stages = wavefront.stage_times();
+  r.closest_packet = wavefront.closest_packet();
+  r.closest_packets = wavefront.packet_timing();
   out.film = passes.film();
   if (options.checkpoint) {
     options.checkpoint(out.film);

@@ -56,6 +56,10 @@ struct RenderReport {
   std::uint64_t texture_bytes = 0, mip_bytes = 0;
   int scene_buffers = 0;  // the buffers it is split over (device_scene.h)
   StageTimes stages;      // with RenderSettings::profile
+  // Closest-hit rays per work-item in a packet (1: the program has none), and how each bounce
+  // index traced its closest-hit rays (Wavefront::closest_packet, packet_timing).
+  std::uint32_t closest_packet = 1;
+  std::vector<PacketTiming> closest_packets;
   // The film holds samples [settings.sample_begin, sample_end): all requested, or fewer when the
   // passes stopped early (`stop`).
   std::uint32_t sample_end = 0;

@@ -88,6 +88,26 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"scene_buffers\":" << r.scene_buffers << ",\"ranks\":" << r.ranks << ",\"outputs\":[";
   for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);
   o << "]";
+  o << ",\"closest_packets\":";
+  if (r.closest_packet <= 1) {
+    o << "null";
+  } else {
+    // Per bounce index: the walk kept and what each cost per ray while it was timed.
+    const auto per_ray = [](const PacketTiming& t, int m) {
+      return t.rays[m] ? num(t.seconds[m] * 1e9 / static_cast<double>(t.rays[m])) : "null";
+    };
+    o << "[";
+    for (std::size_t b = 0; b < r.closest_packets.size(); ++b) {
+      const PacketTiming& t = r.closest_packets[b];
+      o << (b ? "," : "") << "{\"bounce\":" << b << ",\"choice\":"
+        << (t.choice < 0    ? "\"timing\""
+            : t.choice == 1 ? "\"packets\""
+                            : "\"single\"")
+        << ",\"single_ns_per_ray\":" << per_ray(t, 0) << ",\"packet_ns_per_ray\":" << per_ray(t, 1)
+        << ",\"timed_rays\":[" << t.rays[0] << "," << t.rays[1] << "]}";
+    }
+    o << "]";
+  }
   if (s.profile) {
     o << ",\"stage_seconds\":{";
     for (int i = 0; i < kStageCount; ++i)

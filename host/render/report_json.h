@@ -24,7 +24,10 @@ std::map<std::string, std::string> film_exr_attributes(const FilmInfo& film);
 // sample passes), samples_per_second (pixel samples), device, triangles, kernel_build_seconds,
 // bvh_build_seconds, bvh_sah_cost, setup_seconds, first_pass_seconds, load_seconds,
 // total_seconds, nonfinite_samples, rays, features, wave_size, bytes_per_path, scene_bytes,
-// scene_buffers, ranks (processes of an MPI job), outputs, and with
+// scene_buffers, ranks (processes of an MPI job), outputs, closest_packets (null where the
+// program has no closest-hit packets, else per bounce index, the last for every deeper bounce
+// too: {bounce, choice "packets" | "single" | "timing", single_ns_per_ray, packet_ns_per_ray,
+// timed_rays [single, packets]}; a bounce index not listed traced single rays), and with
 // profiling stage_seconds {stage: seconds}.
 std::string report_json(const RenderSettings& settings, const RenderReport& report,
                         double load_seconds, double total_seconds,

@@ -140,6 +140,16 @@ struct StageTimes {
   std::array<std::uint64_t, kStageCount> launches{};
 };
 
+// How the closest-hit rays of one bounce index were traced where the program has packets
+// (Wavefront::packet_timing): intersect_closest's device seconds and rays for each walk while it
+// was timed on the first waves, and the walk kept.
+struct PacketTiming {
+  double seconds[2] = {0.0, 0.0};  // intersect_closest's time [single rays, packets] ...
+  std::uint64_t rays[2] = {0, 0};  // ... over these many rays
+  int launches[2] = {0, 0};        // ... in these many launches
+  int choice = -1;                 // 0 single rays, 1 packets, -1 still timing
+};
+
 class Wavefront {
  public:
   // Packs and uploads the scene, allocates the path state and builds the program. `bvh` must have
@@ -221,6 +231,13 @@ class Wavefront {
   std::size_t samples_per_wave() const { return samples_per_wave_; }
   std::size_t wave_paths() const { return wave_size_ * samples_per_wave_; }
   const StageTimes& stage_times() const { return times_; }
+  // Per bounce index, the last standing for it and every deeper bounce, how its closest-hit rays
+  // were traced (run_wave); a bounce index not (yet) listed traces single rays. Empty where the
+  // program has no closest-hit packets (closest_packet() == 1: GPUs, the binary BVH, instances,
+  // alpha, RenderSettings::closest_packets off).
+  const std::vector<PacketTiming>& packet_timing() const { return packet_timing_; }
+  // Closest-hit rays per work-item where a bounce uses packets; 1 where the program has none.
+  std::uint32_t closest_packet() const { return closest_packet_; }
   std::string build_options() const { return options_; }
   // FNV-1a 64 of the program's source (all stage kernels, includes expanded): part of the render
   // key (render.h), so films of different kernels do not merge.
@@ -273,12 +290,6 @@ class Wavefront {
   std::uint32_t closest_packet_ = 1;  // closest-hit rays per work-item where a bounce uses packets
   // Whether each bounce's closest-hit rays go in packets (closest_packet_ > 1 only): the faster
   // per ray of the two, timed on the first waves (run_wave). The same image either way.
-  struct PacketTiming {
-    double seconds[2] = {0.0, 0.0};  // intersect_closest's time [single, packets] ...
-    std::uint64_t rays[2] = {0, 0};  // ... over these many rays
-    int launches[2] = {0, 0};        // ... in these many launches
-    int choice = -1;                 // 0 single, 1 packets, -1 still timing
-  };
   std::vector<PacketTiming> packet_timing_;
   int packet_mode(std::size_t bounce) const;
   void time_packets(std::size_t bounce, int mode, std::uint32_t rays);
