@@ -127,6 +127,16 @@ typedef struct Surface {
 #endif
 } Surface;
 
+#if WP_SHADE_PACKET
+/* Eight Surfaces of untextured Lambertian materials (common.h, Float3x8): what bsdf_eval8 and
+ * bsdf_sample8 read; front is WP_SURF_FRONT of flags. */
+typedef struct Surface8 {
+  Float3x8 p, ng, ns, color;
+  float8 p_scale;
+  int8 front;
+} Surface8;
+#endif
+
 typedef struct BsdfEval {
   float3 f;  /* BSDF value (no cosine), delta lobes excluded */
   float pdf; /* solid-angle density with which bsdf_sample would produce wi */
@@ -669,6 +679,35 @@ static inline BsdfSample bsdf_sample_view(const Surface* s, const BsdfView* v, f
 #endif
   return r;
 }
+
+#if WP_SHADE_PACKET
+/* bsdf_eval_view and bsdf_sample_view of eight lanes (common.h, Float3x8), cos_o being each
+ * lane's BsdfView: f and the pdf in *pdf; the direction, its pdf in *pdf and whether it is valid
+ * (the weight is the base colour). */
+WP_LANES_FN Float3x8 bsdf_eval8(const Surface8* s, float8 cos_o, Float3x8 wi, float8* pdf) {
+  const float8 cos_i = dot3x8(s->ns, wi);
+  const int8 lit = cos_o > 0.0f && cos_i > 0.0f && dot3x8(s->ng, wi) > 0.0f;
+  *pdf = select((float8)(0.0f), cosine_hemisphere_pdf8(cos_i), lit);
+  Float3x8 f = {select((float8)(0.0f), WP_INV_PI * s->color.x, lit),
+                select((float8)(0.0f), WP_INV_PI * s->color.y, lit),
+                select((float8)(0.0f), WP_INV_PI * s->color.z, lit)};
+  return f;
+}
+
+WP_LANES_FN Float3x8 bsdf_sample8(const Surface8* s, float8 cos_o, float8 ux, float8 uy,
+                                  float8* pdf, int8* valid) {
+  Float3x8 t, b;
+  make_basis8(s->ns, &t, &b);
+  const Float3x8 l = sample_cosine_hemisphere8(ux, uy);
+  Float3x8 w = {l.x * t.x + l.y * b.x + l.z * s->ns.x, l.x * t.y + l.y * b.y + l.z * s->ns.y,
+                l.x * t.z + l.y * b.z + l.z * s->ns.z};
+  w = normalize3x8(w);
+  const float8 cos_i = dot3x8(s->ns, w);
+  *valid = cos_o > 0.0f && l.z > 0.0f && cos_i > 0.0f && dot3x8(s->ng, w) > 0.0f;
+  *pdf = cosine_hemisphere_pdf8(cos_i);
+  return w;
+}
+#endif
 
 /* What a smooth thin-walled transmitter lets a shadow ray along d through: nothing, here. */
 static inline float3 bsdf_pane_transmittance(const Surface* s, float3 d) {

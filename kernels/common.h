@@ -62,4 +62,155 @@ static inline float3 offset_origin(float3 p, float3 n, float scale) {
   return p + n * offset_distance(scale);
 }
 
+#if WP_SHADE_PACKET
+/* Eight paths shaded at once (integrator/shade_packet.h), float8 lanes being paths. Each function
+ * with a twin of eight lanes has it beside itself, written with the same expressions, so that the
+ * twin rounds as it does lane by lane: the program is one translation unit in which traverse.h's
+ * FP_CONTRACT OFF holds for all that follows it, so a header's fused multiply-adds depend on where
+ * it is first included, and a twin in the same header shares them. */
+/* Always inlined: a float8 triple passed to a function kept out of line goes through memory. */
+#define WP_LANES_FN static inline __attribute__((always_inline))
+
+typedef struct Float3x8 {
+  float8 x, y, z;
+} Float3x8;
+
+WP_LANES_FN float lane_of(float8 v, int i) {
+  float a[8];
+  vstore8(v, 0, a);
+  return a[i];
+}
+WP_LANES_FN bool lane_set(int8 mask, int i) {
+  return lane_of(as_float8(mask), i) != 0.0f;
+}
+WP_LANES_FN float3 lane3(Float3x8 v, int i) {
+  return (float3)(lane_of(v.x, i), lane_of(v.y, i), lane_of(v.z, i));
+}
+/* Eight float4 as four float8 of their components, lane i from v[i], and back. */
+WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, float8* w) {
+  const float8 a = (float8)(v[0], v[1]), b = (float8)(v[2], v[3]);
+  const float8 c = (float8)(v[4], v[5]), d = (float8)(v[6], v[7]);
+  *x = (float8)(shuffle2(a, b, (uint4)(0, 4, 8, 12)), shuffle2(c, d, (uint4)(0, 4, 8, 12)));
+  *y = (float8)(shuffle2(a, b, (uint4)(1, 5, 9, 13)), shuffle2(c, d, (uint4)(1, 5, 9, 13)));
+  *z = (float8)(shuffle2(a, b, (uint4)(2, 6, 10, 14)), shuffle2(c, d, (uint4)(2, 6, 10, 14)));
+  *w = (float8)(shuffle2(a, b, (uint4)(3, 7, 11, 15)), shuffle2(c, d, (uint4)(3, 7, 11, 15)));
+}
+WP_LANES_FN void untranspose4x8(float8 x, float8 y, float8 z, float8 w, float4* v) {
+  const float8 xy0 = shuffle2(x, y, (uint8)(0, 8, 1, 9, 2, 10, 3, 11));
+  const float8 xy1 = shuffle2(x, y, (uint8)(4, 12, 5, 13, 6, 14, 7, 15));
+  const float8 zw0 = shuffle2(z, w, (uint8)(0, 8, 1, 9, 2, 10, 3, 11));
+  const float8 zw1 = shuffle2(z, w, (uint8)(4, 12, 5, 13, 6, 14, 7, 15));
+  v[0] = (float4)(xy0.s01, zw0.s01), v[1] = (float4)(xy0.s23, zw0.s23);
+  v[2] = (float4)(xy0.s45, zw0.s45), v[3] = (float4)(xy0.s67, zw0.s67);
+  v[4] = (float4)(xy1.s01, zw1.s01), v[5] = (float4)(xy1.s23, zw1.s23);
+  v[6] = (float4)(xy1.s45, zw1.s45), v[7] = (float4)(xy1.s67, zw1.s67);
+}
+/* Element index[i] of array a in lane i, as three or four float8. */
+WP_LANES_FN void gather4x8(__global const float4* a, const uint* index, float8* x, float8* y,
+                           float8* z, float8* w) {
+  float4 v[8];
+#pragma unroll
+  for (int i = 0; i < 8; ++i) v[i] = a[index[i]];
+  transpose4x8(v, x, y, z, w);
+}
+WP_LANES_FN Float3x8 gather3x8(__global const float4* a, const uint* index) {
+  Float3x8 r;
+  float8 w;
+  gather4x8(a, index, &r.x, &r.y, &r.z, &w);
+  return r;
+}
+
+WP_LANES_FN Float3x8 load3x8(const float* x, const float* y, const float* z) {
+  Float3x8 r = {vload8(0, x), vload8(0, y), vload8(0, z)};
+  return r;
+}
+WP_LANES_FN Float3x8 neg3x8(Float3x8 a) {
+  Float3x8 r = {-a.x, -a.y, -a.z};
+  return r;
+}
+WP_LANES_FN Float3x8 sub3x8(Float3x8 a, Float3x8 b) {
+  Float3x8 r = {a.x - b.x, a.y - b.y, a.z - b.z};
+  return r;
+}
+WP_LANES_FN Float3x8 div3x8(Float3x8 a, float8 d) {
+  Float3x8 r = {a.x / d, a.y / d, a.z / d};
+  return r;
+}
+/* Lane by lane: b where take_b, else a. */
+WP_LANES_FN Float3x8 select3x8(Float3x8 a, Float3x8 b, int8 take_b) {
+  Float3x8 r = {select(a.x, b.x, take_b), select(a.y, b.y, take_b), select(a.z, b.z, take_b)};
+  return r;
+}
+WP_LANES_FN float8 max3x8(Float3x8 a) {
+  return fmax(a.x, fmax(a.y, a.z));
+}
+WP_LANES_FN int8 finite3x8(Float3x8 a) {
+  return isfinite(a.x) & isfinite(a.y) & isfinite(a.z);
+}
+
+/* The builtins dot and cross: their products are not fused (checked against PoCL's). */
+WP_LANES_FN float8 dot3x8(Float3x8 a, Float3x8 b) {
+#pragma OPENCL FP_CONTRACT OFF
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+WP_LANES_FN Float3x8 cross3x8(Float3x8 a, Float3x8 b) {
+#pragma OPENCL FP_CONTRACT OFF
+  Float3x8 r = {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  return r;
+}
+
+/* The builtins length and normalize: sqrt(dot) and v * (1 / sqrt(dot)) where the squared length
+ * is within (1e-30, 1e30), as checked against PoCL's; outside it they scale first, and the lanes
+ * there take the builtin itself. */
+WP_LANES_FN int8 plain_length(float8 dd) {
+  return dd > 1e-30f && dd < 1e30f;
+}
+WP_LANES_FN float8 length3x8(Float3x8 a) {
+  const float8 dd = dot3x8(a, a);
+  float8 r = sqrt(dd);
+  const int8 plain = plain_length(dd);
+  if (!all(plain)) {
+    float l[8];
+    vstore8(r, 0, l);
+    for (int i = 0; i < 8; ++i)
+      if (!lane_set(plain, i)) l[i] = length(lane3(a, i));
+    r = vload8(0, l);
+  }
+  return r;
+}
+WP_LANES_FN Float3x8 normalize3x8(Float3x8 a) {
+  const float8 dd = dot3x8(a, a);
+  const float8 inv = 1.0f / sqrt(dd);
+  Float3x8 r = {a.x * inv, a.y * inv, a.z * inv};
+  const int8 plain = plain_length(dd);
+  if (!all(plain)) {
+    float x[8], y[8], z[8];
+    vstore8(r.x, 0, x), vstore8(r.y, 0, y), vstore8(r.z, 0, z);
+    for (int i = 0; i < 8; ++i)
+      if (!lane_set(plain, i)) {
+        const float3 n = normalize(lane3(a, i));
+        x[i] = n.x, y[i] = n.y, z[i] = n.z;
+      }
+    r = load3x8(x, y, z);
+  }
+  return r;
+}
+
+WP_LANES_FN void make_basis8(Float3x8 n, Float3x8* t, Float3x8* b) {
+  const float8 s = select((float8)(-1.0f), (float8)(1.0f), n.z >= 0.0f);
+  const float8 a = -1.0f / (s + n.z);
+  const float8 c = n.x * n.y * a;
+  t->x = 1.0f + s * n.x * n.x * a, t->y = s * c, t->z = -s * n.x;
+  b->x = c, b->y = s + n.y * n.y * a, b->z = -n.y;
+}
+WP_LANES_FN float8 offset_distance8(float8 scale) {
+  return scale * (1.0f / 65536.0f);
+}
+WP_LANES_FN Float3x8 offset_origin8(Float3x8 p, Float3x8 n, float8 scale) {
+  Float3x8 r = {p.x + n.x * offset_distance8(scale), p.y + n.y * offset_distance8(scale),
+                p.z + n.z * offset_distance8(scale)};
+  return r;
+}
+#endif
+
 #endif /* WP_COMMON_H */

@@ -120,6 +120,18 @@ static inline float2 cos_sin_quarter(float t) {
   return (float2)(c, s);
 }
 
+#if WP_SHADE_PACKET
+/* cos_sin_quarter of eight angles (common.h, Float3x8). */
+WP_LANES_FN void cos_sin_quarter8(float8 t, float8* c, float8* s) {
+  const float8 t2 = t * t;
+  *c = 1.0f +
+       t2 * (-0.5f + t2 * (1.0f / 24.0f + t2 * (-1.0f / 720.0f + t2 * (1.0f / 40320.0f -
+                                                                       t2 * (1.0f / 3628800.0f)))));
+  *s = t * (1.0f + t2 * (-1.0f / 6.0f +
+                         t2 * (1.0f / 120.0f + t2 * (-1.0f / 5040.0f + t2 * (1.0f / 362880.0f)))));
+}
+#endif
+
 /* (cos, sin) of the angle 2 pi u for u in [0, 1]: the nearest quarter turn q and the rest t,
  * |t| <= pi/4 (x - q is exact), by cos_sin_quarter, rotated by q quarter turns. No call to the
  * library's cos and sin, whose argument reduction PoCL keeps out of line. */
@@ -132,6 +144,19 @@ static inline float2 cos_sin_turn(float u) {
   const float s = k == 0 ? cs.y : k == 1 ? cs.x : k == 2 ? -cs.y : -cs.x;
   return (float2)(c, s);
 }
+
+#if WP_SHADE_PACKET
+/* cos_sin_turn of eight lanes (common.h, Float3x8). */
+WP_LANES_FN void cos_sin_turn8(float8 u, float8* c, float8* s) {
+  const float8 x = 4.0f * u;
+  const float8 q = floor(x + 0.5f);
+  float8 qc, qs;
+  cos_sin_quarter8((x - q) * (0.5f * WP_PI), &qc, &qs);
+  const int8 k = convert_int8(q) & 3;
+  *c = select(select(select(qs, -qc, k == 2), -qs, k == 1), qc, k == 0);
+  *s = select(select(select(-qc, -qs, k == 2), qc, k == 1), qs, k == 0);
+}
+#endif
 
 /* cos x for finite x: x in turns less its whole turns (exact), then cos_sin_turn. The turns are off
  * by 2 u of themselves (the float 1 / (2 pi) and the product), 2 u |x| in the angle, so the error

@@ -218,6 +218,19 @@ static inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, f
   return scene->desc->background.xyz;
 }
 
+#if WP_SHADE_PACKET
+/* env_sample's direction of eight lanes (common.h, Float3x8) for the constant background (no
+ * map), whose radiance is the background and pdf 1 / (4 pi) in every lane. */
+WP_LANES_FN Float3x8 env_sample_uniform8(float8 ux, float8 uy) {
+  const float8 z = 1.0f - 2.0f * ux;
+  const float8 r = sqrt(fmax(0.0f, 1.0f - z * z));
+  float8 c, s;
+  cos_sin_turn8(uy, &c, &s);
+  Float3x8 dir = {r * c, z, r * s};
+  return dir;
+}
+#endif
+
 /* The solid-angle density with which env_sample produces dir. */
 static inline float env_pdf(const SceneView* scene, float3 dir) {
   float pdf;

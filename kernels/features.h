@@ -16,6 +16,11 @@
 #ifndef WP_CLOSEST_PACKET
 #define WP_CLOSEST_PACKET 0
 #endif
+/* The fused shade kernel for eight paths per work-item (integrator/shade_packet.h): the host's
+ * choice, for untextured Lambertian scenes. */
+#ifndef WP_SHADE_PACKET
+#define WP_SHADE_PACKET 0
+#endif
 #ifndef WP_FEATURE_PUNCTUAL_LIGHTS
 #define WP_FEATURE_PUNCTUAL_LIGHTS 1 /* point, spot or directional lights */
 #endif

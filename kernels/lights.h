@@ -126,6 +126,61 @@ static inline LightSample sample_triangle(const SceneView* scene, uint inst, uin
   return s;
 }
 
+#if WP_SHADE_PACKET
+/* A light sample of eight lanes (common.h): LightSample's fields that a triangle's sample sets. */
+typedef struct LightSample8 {
+  Float3x8 wi, li, target;
+  float8 dist, pdf;
+} LightSample8;
+
+/* sample_triangle of eight lanes, the triangles tri[i] (no instances, untextured emission) for
+ * the shading points p at (ux, uy). */
+WP_LANES_FN LightSample8 sample_triangle8(const SceneView* scene, const uint* tri, Float3x8 p,
+                                          float8 ux, float8 uy) {
+  uint i0[8], i1[8], i2[8];
+  float4 e[8]; /* material_emission, untextured; w: double-sided */
+#pragma unroll
+  for (int i = 0; i < 8; ++i) {
+    const uint4 tv = scene->tri_vertices[tri[i]];
+    i0[i] = tv.x, i1[i] = tv.y, i2[i] = tv.z;
+    __global const Material* m = scene->materials + tv.w;
+    e[i] = (float4)(m->emission.xyz, (m->flags.x & WP_MAT_DOUBLE_SIDED) ? 1.0f : 0.0f);
+  }
+  Float3x8 li;
+  float8 ds;
+  transpose4x8(e, &li.x, &li.y, &li.z, &ds);
+  LightSample8 s;
+  const Float3x8 p0 = gather3x8(scene->positions, i0);
+  const Float3x8 e1 = sub3x8(gather3x8(scene->positions, i1), p0);
+  const Float3x8 e2 = sub3x8(gather3x8(scene->positions, i2), p0);
+  const float8 r = sqrt(ux);
+  const float8 b1 = r * (1.0f - uy), b2 = r * uy;
+  const Float3x8 q = {p0.x + b1 * e1.x + b2 * e2.x, p0.y + b1 * e1.y + b2 * e2.y,
+                      p0.z + b1 * e1.z + b2 * e2.z};
+  const Float3x8 p1 = {p0.x + e1.x, p0.y + e1.y, p0.z + e1.z};
+  const Float3x8 p2 = {p0.x + e2.x, p0.y + e2.y, p0.z + e2.z};
+  const float8 q_scale =
+      fmax(fabs((1.0f - b1 - b2) * p0.x) + fabs(b1 * p1.x) + fabs(b2 * p2.x),
+           fmax(fabs((1.0f - b1 - b2) * p0.y) + fabs(b1 * p1.y) + fabs(b2 * p2.y),
+                fabs((1.0f - b1 - b2) * p0.z) + fabs(b1 * p1.z) + fabs(b2 * p2.z)));
+  const Float3x8 n = cross3x8(e1, e2);
+  const float8 area2 = length3x8(n);
+  const Float3x8 to_light = sub3x8(q, p);
+  s.dist = length3x8(to_light);
+  s.wi = div3x8(to_light, s.dist);
+  const float8 cos_light = -dot3x8(n, s.wi) / area2;
+  const int8 double_sided = ds != 0.0f;
+  const int8 seen = s.dist > 0.0f && (cos_light > 0.0f || (double_sided && cos_light < 0.0f));
+  /* triangle_solid_angle_pdf */
+  const float8 area = 0.5f * area2;
+  s.pdf = select((float8)(0.0f), s.dist * s.dist / (area * fabs(cos_light)), seen);
+  s.target = offset_origin8(
+      q, select3x8(div3x8(neg3x8(n), area2), div3x8(n, area2), cos_light > 0.0f), q_scale);
+  s.li = select3x8((Float3x8){0.0f, 0.0f, 0.0f}, li, seen);
+  return s;
+}
+#endif
+
 /* With at most this many lights, one 2D number both picks the light (its first coordinate) and
  * places the point on it (what is left of that coordinate, and the second), as Mitsuba does: the
  * points of a pixel's samples then stay one stratified set over all the lights together (a quad

@@ -299,4 +299,64 @@ static inline Surface resolve_surface(const SceneView* scene, uint inst, uint tr
   return s;
 }
 
+#if WP_SHADE_PACKET
+/* interpolate3 of eight lanes (common.h, Float3x8), the lanes' values at the corners given. */
+WP_LANES_FN Float3x8 interpolate3x8(Float3x8 a0, Float3x8 a1, Float3x8 a2, float8 u, float8 v) {
+  Float3x8 r = {(1.0f - u - v) * a0.x + u * a1.x + v * a2.x,
+                (1.0f - u - v) * a0.y + u * a1.y + v * a2.y,
+                (1.0f - u - v) * a0.z + u * a1.z + v * a2.z};
+  return r;
+}
+
+/* resolve_surface of eight lanes for a program of untextured Lambertian materials without
+ * instances (shade_packet.h): triangle tri[i] hit at (u, v) by a ray along ray_d, lane by lane;
+ * its vertices and material in tv[i]. */
+WP_LANES_FN Surface8 resolve_surface8(const SceneView* scene, const uint* tri, float8 u, float8 v,
+                                      Float3x8 ray_d, uint4* tv) {
+  uint i0[8], i1[8], i2[8];
+  float4 c[8];
+#pragma unroll
+  for (int i = 0; i < 8; ++i) {
+    tv[i] = scene->tri_vertices[tri[i]];
+    i0[i] = tv[i].x, i1[i] = tv[i].y, i2[i] = tv[i].z;
+    c[i] = scene->materials[tv[i].w].base_color;
+  }
+  const Float3x8 p0 = gather3x8(scene->positions, i0), p1 = gather3x8(scene->positions, i1),
+                 p2 = gather3x8(scene->positions, i2);
+  Surface8 s;
+  s.p = interpolate3x8(p0, p1, p2, u, v);
+  s.p_scale = fmax(fabs((1.0f - u - v) * p0.x) + fabs(u * p1.x) + fabs(v * p2.x),
+                   fmax(fabs((1.0f - u - v) * p0.y) + fabs(u * p1.y) + fabs(v * p2.y),
+                        fabs((1.0f - u - v) * p0.z) + fabs(u * p1.z) + fabs(v * p2.z)));
+  const Float3x8 n = cross3x8(sub3x8(p1, p0), sub3x8(p2, p0));
+  const float8 len = length3x8(n);
+  s.ng = select3x8(neg3x8(ray_d), div3x8(n, len), len > 0.0f);
+  s.front = dot3x8(s.ng, ray_d) < 0.0f;
+  s.ng = select3x8(neg3x8(s.ng), s.ng, s.front);
+  const Float3x8 n_front =
+      normalize3x8(interpolate3x8(gather3x8(scene->normals, i0), gather3x8(scene->normals, i1),
+                                  gather3x8(scene->normals, i2), u, v));
+  s.ns = select3x8(n_front, neg3x8(n_front), dot3x8(n_front, s.ng) < 0.0f);
+  s.ns = select3x8(s.ng, s.ns, dot3x8(s.ns, neg3x8(ray_d)) > 1e-4f);
+  float8 unused;
+  transpose4x8(c, &s.color.x, &s.color.y, &s.color.z, &unused);
+  return s;
+}
+
+/* Lane i of *s as resolve_surface gives it (for the functions of one path): the material's part
+ * read again. */
+WP_LANES_FN Surface surface_lane(const SceneView* scene, const Surface8* s, uint4 tv, int i) {
+  Surface r;
+  r.p = lane3(s->p, i);
+  r.p_scale = lane_of(s->p_scale, i);
+  r.ng = lane3(s->ng, i);
+  r.ns = lane3(s->ns, i);
+  TexPoint tp;
+  tp.uv = (float4)(0.0f);
+  resolve_material(scene, scene->materials + tv.w, tv, 0.0f, 0.0f, tp, &r);
+  r.flags = lane_set(s->front, i) ? WP_SURF_FRONT : 0u;
+  return r;
+}
+#endif
+
 #endif /* WP_MATERIAL_H */

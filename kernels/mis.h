@@ -56,4 +56,23 @@ static inline float mis_weight_light(float p_light, float p_bsdf, bool delta) {
 #endif
 }
 
+#if WP_SHADE_PACKET
+/* mis_weight_light of eight lanes (common.h) for lights that are not delta lights. */
+WP_LANES_FN float8 mis_weight_light8(float8 p_light, float8 p_bsdf) {
+#if WP_STRATEGY == WP_STRATEGY_MIS
+  const float8 r = p_bsdf / p_light;
+#if WP_MIS_POWER
+  const float8 w = 1.0f / (1.0f + r * r);
+#else
+  const float8 w = 1.0f / (1.0f + r);
+#endif
+  const float8 inf_own = select((float8)(1.0f), (float8)(0.5f), isinf(p_bsdf));
+  return select(select(w, inf_own, isinf(p_light)), (float8)(1.0f), !(p_bsdf > 0.0f));
+#else
+  (void)p_light, (void)p_bsdf;
+  return (float8)(1.0f);
+#endif
+}
+#endif
+
 #endif /* WP_MIS_H */

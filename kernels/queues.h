@@ -41,21 +41,21 @@ static inline int queue_get_run(Queues qs, uint q, uint first, int count, uint* 
   return n;
 }
 
-/* Two queue_push_group calls (below) in one: slot goes to queue qa where push_a holds and to queue
- * qb where push_b holds, with one scan of both flags packed in a word (a group's ranks fit in 16
- * bits: WP_GROUP_SIZE <= 1024), so half the barriers and scans of two calls. Each queue's entries
- * come out in the order two calls would give them. */
-static inline void queue_push_group2(Queues qs, uint qa, bool push_a, uint qb, bool push_b,
-                                     uint slot, __local uint* scan) {
+/* queue_push_group2 (below) for a work-item with several slots, slots[0, n): slot i goes to queue
+ * qa where bit i of push_a is set and to queue qb where bit i of push_b is set (shade_packet.h),
+ * each queue's entries in slot order within the work-item. A group pushes at most
+ * WP_GROUP_SIZE * 32 slots to a queue, whose ranks fit in 16 bits. */
+static inline void queue_push_group2_n(Queues qs, uint qa, uint push_a, uint qb, uint push_b,
+                                       const uint* slots, int n, __local uint* scan) {
   const uint lid = get_local_id(0);
-  scan[lid] = (push_a ? 1u : 0u) | (push_b ? 0x10000u : 0u);
+  scan[lid] = popcount(push_a) | (popcount(push_b) << 16);
   barrier(CLK_LOCAL_MEM_FENCE);
   if (lid == 0u) { /* serial, by one work-item: a CPU runs the group as one loop anyway */
     uint total = 0u;
     for (uint i = 0u; i < WP_GROUP_SIZE; ++i) {
-      const uint flag = scan[i];
+      const uint count = scan[i];
       scan[i] = total;
-      total += flag;
+      total += count;
     }
     const uint ta = total & 0xffffu, tb = total >> 16;
     scan[WP_GROUP_SIZE] = ta ? atomic_add(&qs.counters[qa], ta) : 0u;
@@ -63,8 +63,21 @@ static inline void queue_push_group2(Queues qs, uint qa, bool push_a, uint qb, b
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   const uint rank = scan[lid];
-  if (push_a) qs.slots[qa * qs.capacity + scan[WP_GROUP_SIZE] + (rank & 0xffffu)] = slot;
-  if (push_b) qs.slots[qb * qs.capacity + scan[WP_GROUP_SIZE + 1u] + (rank >> 16)] = slot;
+  uint a = qa * qs.capacity + scan[WP_GROUP_SIZE] + (rank & 0xffffu);
+  uint b = qb * qs.capacity + scan[WP_GROUP_SIZE + 1u] + (rank >> 16);
+  for (int i = 0; i < n; ++i) {
+    if ((push_a >> i) & 1u) qs.slots[a++] = slots[i];
+    if ((push_b >> i) & 1u) qs.slots[b++] = slots[i];
+  }
+}
+
+/* Two queue_push_group calls (below) in one: slot goes to queue qa where push_a holds and to queue
+ * qb where push_b holds, with one scan of both flags packed in a word (a group's ranks fit in 16
+ * bits: WP_GROUP_SIZE <= 1024), so half the barriers and scans of two calls. Each queue's entries
+ * come out in the order two calls would give them. */
+static inline void queue_push_group2(Queues qs, uint qa, bool push_a, uint qb, bool push_b,
+                                     uint slot, __local uint* scan) {
+  queue_push_group2_n(qs, qa, push_a ? 1u : 0u, qb, push_b ? 1u : 0u, &slot, 1, scan);
 }
 
 /* Appends `slot` to queue `q` where `push` holds, for the whole work-group at once: a scan of the

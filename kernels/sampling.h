@@ -30,6 +30,25 @@ static inline float cosine_hemisphere_pdf(float cos_theta) {
   return fmax(cos_theta, 0.0f) * WP_INV_PI;
 }
 
+#if WP_SHADE_PACKET
+/* sample_cosine_hemisphere and cosine_hemisphere_pdf of eight lanes (common.h, Float3x8). */
+WP_LANES_FN Float3x8 sample_cosine_hemisphere8(float8 ux, float8 uy) {
+  const float8 sx = 2.0f * ux - 1.0f, sy = 2.0f * uy - 1.0f;
+  const int8 wide = fabs(sx) > fabs(sy);
+  float8 c, s;
+  cos_sin_quarter8(select((WP_PI / 4.0f) * (sx / sy), (WP_PI / 4.0f) * (sy / sx), wide), &c, &s);
+  const int8 centre = sx == 0.0f && sy == 0.0f;
+  Float3x8 r;
+  r.x = select(select(sy * s, sx * c, wide), (float8)(0.0f), centre);
+  r.y = select(select(sy * c, sx * s, wide), (float8)(0.0f), centre);
+  r.z = sqrt(fmax(0.0f, 1.0f - r.x * r.x - r.y * r.y));
+  return r;
+}
+WP_LANES_FN float8 cosine_hemisphere_pdf8(float8 cos_theta) {
+  return fmax(cos_theta, 0.0f) * WP_INV_PI;
+}
+#endif
+
 /* GGX (Trowbridge-Reitz) normal distribution D(h) for alpha = roughness^2, from the cosine and
  * the squared sine of h's angle to the normal. The textbook denominator cos^2 (alpha^2 - 1) + 1
  * cancels in float32 for small alpha: alpha^2 below half an ulp of 1 (alpha < 2.4e-4) makes

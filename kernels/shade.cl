@@ -10,10 +10,18 @@
 #include "integrator/sample_bsdf.h"
 #include "integrator/sample_lights.h"
 #include "integrator/shade_surface.h"
+#include "integrator/shade_packet.h"
 
 WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
   WP_STAGE_BIND;
   WP_GROUP_SCRATCH(scan);
+#if WP_SHADE_PACKET
+  /* Eight paths per work-item (integrator/shade_packet.h), each shaded as below. */
+  uint slots[WP_SHADE_LANES], shadow, survives;
+  const int n = shade_packet(&scene, paths, queues, launch, get_global_id(0) * WP_SHADE_LANES,
+                             slots, &shadow, &survives);
+  queue_push_group2_n(queues, WP_QUEUE_SHADOW, shadow, launch.queue_out, survives, slots, n, scan);
+#else
   uint slot = 0u;
   bool shadow = false, survives = false;
   uint ahead;
@@ -43,5 +51,6 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
   queue_push_group2(queues, WP_QUEUE_SHADOW, shadow, launch.queue_out, survives, slot, scan);
 #else
   queue_push_group(queues, launch.queue_out, survives, slot, scan);
+#endif
 #endif
 }

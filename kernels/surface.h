@@ -100,4 +100,14 @@ static inline float3 surface_spawn(const Surface* s, float3 d_in, float t_in, fl
   return offset_origin(s->p, -s->ng, s->p_scale);
 }
 
+#if WP_SHADE_PACKET
+/* surface_spawn of eight lanes (common.h, Float3x8). */
+WP_LANES_FN Float3x8 surface_spawn8(const Surface8* s, Float3x8 d_in, float8 t_in, Float3x8 wi) {
+  const float8 back = fmin(offset_distance8(s->p_scale), 0.5f * t_in);
+  const Float3x8 q = {s->p.x - d_in.x * back, s->p.y - d_in.y * back, s->p.z - d_in.z * back};
+  return select3x8(offset_origin8(s->p, neg3x8(s->ng), s->p_scale),
+                   offset_origin8(q, s->ng, s->p_scale), dot3x8(wi, s->ng) > 0.0f);
+}
+#endif
+
 #endif /* WP_SURFACE_H */

@@ -634,6 +634,48 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
   }
 }
 
+// In a scene of untextured Lambertian surfaces the fused kernel shades eight paths per work-item
+// on PoCL's CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path
+// kernel's bit for bit, with every kind of light sample (the lamp's triangles and the constant
+// background in SIMD lanes, the point light by the single-path function), each sampler and
+// strategy, and several waves of different sizes (which paths share a packet changes nothing).
+TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
+  wp::Scene s = busy_scene();
+  s.materials[1] = wp::test::diffuse_material(vec3(0.9f, 0.5f, 0.2f));
+  s.materials[2] = wp::test::diffuse_material(vec3(0.3f, 0.8f, 0.6f));
+  // Lambert alone: glTF's default specular factor 1 is a dielectric layer (a glossy program).
+  for (wp::Material& m : s.materials) m.specular = 0.0f;
+  using wp::Sampler, wp::Strategy;
+  for (const auto& [sampler, strategy, wave] :
+       std::vector<std::tuple<Sampler, Strategy, std::size_t>>{
+           {Sampler::kSobol, Strategy::kMis, 1000},
+           {Sampler::kSobol, Strategy::kNee, 0},
+           {Sampler::kSobol, Strategy::kBsdf, 1000},
+           {Sampler::kIndependent, Strategy::kMis, 0}}) {
+    SCOPED_TRACE(std::string(sampler == wp::Sampler::kSobol ? "sobol" : "independent") +
+                 ", strategy " + std::to_string(static_cast<int>(strategy)) + ", wave " +
+                 std::to_string(wave));
+    wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
+    st.sampler = sampler;
+    st.strategy = strategy;
+    st.wave_size = wave;
+    st.spp = 4;
+    const wp::Rendered packets = wp::render(*runtime_, s, st);
+    const wp::DeviceEntry& device = runtime_->device();
+    if (!device.gpu && device.platform_name == "Portable Computing Language") {
+      EXPECT_NE(packets.report.build_options.find("-D WP_SHADE_PACKET=1"), std::string::npos)
+          << packets.report.build_options;
+    }
+    st.shade_packets = false;
+    const wp::Rendered single = wp::render(*runtime_, s, st);
+    EXPECT_EQ(single.report.build_options.find("WP_SHADE_PACKET"), std::string::npos);
+    double sum = 0.0;
+    for (float v : packets.image.rgb) sum += v;
+    EXPECT_GT(sum, 0.0);
+    EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ";
+  }
+}
+
 // The fused shading kernel (kernels/shade.cl) runs the split stages' functions in the same order
 // per path with the same random numbers, so it must give their image bit for bit: with every
 // feature built, AOVs on and off, each sampler, and a thin glass pane (transmission's shadow-ray

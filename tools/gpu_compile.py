@@ -101,10 +101,12 @@ def wavepath_options(wavepath, scene, features):
     if run.returncode != 0:
         fail(f"wavepath failed on {scene['path']}:\n{run.stderr}")
     report = json.loads(run.stdout.strip().splitlines()[-1])
-    # The host adds the cache hints (WP_PREFETCH) and ray packets (WP_SHADOW_PACKET,
-    # WP_CLOSEST_PACKET) for PoCL's CPU devices only: a GPU's build has none, so neither do these.
+    # The host adds the cache hints (WP_PREFETCH) and packets of rays and paths (WP_SHADOW_PACKET,
+    # WP_CLOSEST_PACKET, WP_SHADE_PACKET) for PoCL's CPU devices only: a GPU's build has none, so
+    # neither do these.
     options = re.sub(
-        r" -D WP_(PREFETCH|SHADOW_PACKET|CLOSEST_PACKET)=\d+", "", report["build_options"]
+        r" -D WP_(PREFETCH|SHADOW_PACKET|CLOSEST_PACKET|SHADE_PACKET)=\d+", "",
+        report["build_options"]
     )
     return options, report["features"]
 

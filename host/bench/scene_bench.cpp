@@ -81,11 +81,12 @@ const BounceCapture& SceneBench::bounce(int b) {
   return bounces_.at(static_cast<std::size_t>(b));
 }
 
-// The split pipeline's bounce step of `stage` (pipeline.h).
+// The bounce step of `stage` (pipeline.h): the split pipeline's, or the fused shade's.
 const Step& bounce_step(Stage stage) {
-  for (const Step& step : split_pipeline().bounce)
-    if (step.stage == stage) return step;
-  throw Error(std::string(stage_name(stage)) + " is not a stage of the split pipeline's bounce");
+  for (const Pipeline* pipeline : {&split_pipeline(), &fused_pipeline()})
+    for (const Step& step : pipeline->bounce)
+      if (step.stage == stage) return step;
+  throw Error(std::string(stage_name(stage)) + " is not a stage of a pipeline's bounce");
 }
 
 StageJob SceneBench::stage_job(Stage stage, int b) {
@@ -121,9 +122,11 @@ StageJob SceneBench::stage_job(Stage stage, int b) {
     for (std::uint32_t rays = c.rays; rays > 0;) rays = wf.run_bounce(p, rays);
   } else if (in_bounce(stage)) {
     // The bounce's steps before this one, each over the bounce's rays (an upper bound of every
-    // queue: the work-items past a queue's end return at once).
+    // queue: the work-items past a queue's end return at once); the fused shade's input is
+    // shade_surface's, the hits of intersect_closest.
+    const Stage until = stage == Stage::kShade ? Stage::kShadeSurface : stage;
     for (const Step& step : split_pipeline().bounce) {
-      if (step.stage == stage) break;
+      if (step.stage == until) break;
       wf.launch_stage(step.stage, c.rays, c.params);
     }
   }

@@ -171,9 +171,12 @@ void add(const SceneSpec& scene, Stage stage, const std::string& bounce, int b) 
 
 void register_stage_benchmarks(const SceneSpec& scene) {
   add(scene, Stage::kGenerateCameraRays, "bounce0", 0);
-  for (int b = 0; b < kBounces; ++b)
+  for (int b = 0; b < kBounces; ++b) {
     for (const Step& step : split_pipeline().bounce)  // in the order the split pipeline runs them
       add(scene, step.stage, "bounce" + std::to_string(b), b);
+    // The default (fused) pipeline's one shading kernel, on shade_surface's input.
+    add(scene, Stage::kShade, "bounce" + std::to_string(b), b);
+  }
   // After the wave's last bounce: the state it reads is that of every finished path.
   add(scene, Stage::kAccumulate, "final", 0);
 }

@@ -324,6 +324,10 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
                 "Trace each closest-hit ray on its own (by default PoCL's CPU devices trace them "
                 "eight to a work-item in scenes without instances or alpha; the same image either "
                 "way)");
+  app->add_flag("--no-shade-packets", cli.no_shade_packets,
+                "Shade each path on its own (by default PoCL's CPU devices shade eight paths to a "
+                "work-item in SIMD lanes where every surface is untextured Lambertian, without "
+                "instances or AOVs; the same image either way)");
   app->add_option("--scene-buffer-kib", cli.scene_buffer_kib,
                   "Most KiB per scene buffer; the scene is split over up to 8 [default: the "
                   "device's largest allocation, see `wavepath devices`]");
@@ -454,6 +458,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   settings.prefetch = !cli.no_prefetch;
   settings.shadow_packets = !cli.no_shadow_packets;
   settings.closest_packets = !cli.no_closest_packets;
+  settings.shade_packets = !cli.no_shade_packets;
   if (!cli.no_kernel_cache) settings.kernel_cache_dir = wp::cache_dir();
   if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);

@@ -40,6 +40,7 @@ struct CliOptions {
   bool no_prefetch = false;
   bool no_shadow_packets = false;
   bool no_closest_packets = false;
+  bool no_shade_packets = false;
   bool no_kernel_cache = false;
   std::string features = "scene";
   std::string tonemap = "aces";

@@ -138,6 +138,16 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   closest_packet_ = settings.closest_packets && packets ? 8u : 1u;
   if (shadow_packet_ > 1) options_ += " -D WP_SHADOW_PACKET=1";
   if (closest_packet_ > 1) options_ += " -D WP_CLOSEST_PACKET=1";
+  // Shading eight paths per work-item, float8 lanes being paths, where every scattering surface
+  // is Lambertian and untextured (kernels/integrator/shade_packet.h says what it needs).
+  const SceneFeatures& f = features_;
+  const bool lambertian = !f.glossy && !f.textures && !f.texture_lod && !f.normal_maps &&
+                          !f.vertex_colors && !f.alpha && !f.unlit && !f.transmission &&
+                          !f.volume && !f.specular && !f.clearcoat && !f.sheen && !f.anisotropy &&
+                          !f.iridescence && !f.diffuse_transmission && !f.dispersion &&
+                          !f.instances;
+  shade_packet_ = settings.shade_packets && pocl_cpu && lambertian && !settings.aov ? 8u : 1u;
+  if (shade_packet_ > 1) options_ += " -D WP_SHADE_PACKET=1";
   memory_ = state_memory(settings, features_);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
@@ -269,6 +279,7 @@ void Wavefront::prime_kernels() {
 cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
   if (items == 0) return cl::Event();
   if (stage == Stage::kTraceShadow) items = (items + shadow_packet_ - 1) / shadow_packet_;
+  if (stage == Stage::kShade) items = (items + shade_packet_ - 1) / shade_packet_;
   if (stage == Stage::kIntersectClosest && closest_packet_ > 1 && params.packet > 1)
     items = (items + closest_packet_ - 1) / closest_packet_;
   const std::size_t local = local_size_;

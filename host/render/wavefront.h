@@ -90,6 +90,10 @@ struct RenderSettings {
   // Closest-hit rays likewise, where the program has no instances or alpha (the same walk's
   // closest-hit form: the answer does not depend on which rays share a packet).
   bool closest_packets = true;
+  // The fused shade kernel eight paths per work-item (kernels/integrator/shade_packet.h) on
+  // PoCL's CPU devices, in scenes of untextured Lambertian surfaces without instances or AOVs.
+  // The same image.
+  bool shade_packets = true;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Where built kernel programs are cached (host/device/program_cache.h; the command line passes
   // bvh::cache_dir()); empty: nothing is cached.
@@ -288,6 +292,7 @@ class Wavefront {
   std::size_t local_size_ = 0;
   std::uint32_t shadow_packet_ = 1;   // shadow rays per work-item (kernels/traverse8_packet.h)
   std::uint32_t closest_packet_ = 1;  // closest-hit rays per work-item where a bounce uses packets
+  std::uint32_t shade_packet_ = 1;    // paths per work-item of the fused shade kernel
   // Whether each bounce's closest-hit rays go in packets (closest_packet_ > 1 only): the faster
   // per ray of the two, timed on the first waves (run_wave). The same image either way.
   std::vector<PacketTiming> packet_timing_;

@@ -56,4 +56,36 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
   path_store_ray_d(paths, slot, bs.wi, pane_distance);
 }
 
+#if WP_SHADE_PACKET
+/* sample_next_ray of eight lanes (common.h, shade_packet.h) for the paths in slots[i] whose bit
+ * is set in `lanes`: surface s seen at cosine cos_o, hit at distance t along ray_d, throughput
+ * beta, (ux, uy) the direction's numbers. */
+WP_LANES_FN void sample_next_ray8(Paths paths, Queues queues, const uint* slots, uint lanes,
+                                  const Surface8* s, float8 cos_o, Float3x8 ray_d, float8 t,
+                                  Float3x8 beta, float8 ux, float8 uy) {
+  float8 pdf;
+  int8 valid;
+  const Float3x8 wi = bsdf_sample8(s, cos_o, ux, uy, &pdf, &valid);
+  const Float3x8 next = {beta.x * s->color.x, beta.y * s->color.y, beta.z * s->color.z};
+  const int8 finite = finite3x8(next) && isfinite(pdf);
+  const Float3x8 o = surface_spawn8(s, ray_d, t, wi);
+#pragma unroll
+  for (int i = 0; i < 8; ++i) {
+    if (!((lanes >> i) & 1u)) continue;
+    const uint slot = slots[i];
+    if (lane_set(valid, i) && !lane_set(finite, i)) count_nonfinite(queues);
+    if (!lane_set(valid, i) || !lane_set(finite, i)) {
+      path_store_throughput(paths, slot, (float3)(0.0f), 0.0f);
+      continue;
+    }
+    /* a Lambertian sample: eta scale times 1, no flags (no delta lobe) */
+    path_set_eta_scale(paths, slot, path_eta_scale(paths, slot) * 1.0f);
+    path_set_flags(paths, slot, 0u);
+    path_store_throughput(paths, slot, lane3(next, i), lane_of(pdf, i));
+    path_store_ray_o(paths, slot, lane3(o, i), 0.0f);
+    path_store_ray_d(paths, slot, lane3(wi, i), 0.0f);
+  }
+}
+#endif
+
 #endif /* WP_INTEGRATOR_SAMPLE_BSDF_H */

@@ -47,6 +47,57 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
   path_set_shadow_radiance(paths, slot, c);
   return true;
 }
+
+#if WP_SHADE_PACKET
+/* sample_light_ray of eight lanes (common.h, shade_packet.h) for the paths in slots[i] whose bit
+ * is set in `lanes`: their light is emissive triangle tri[i], or the constant background where
+ * bit i of `env` is set, picked with probability pmf, the point at (ux, uy); surface s seen at
+ * cosine cos_o, hit at distance t along ray_d, throughput beta. Returns the lanes with a shadow
+ * ray. */
+WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues queues,
+                                   const uint* slots, uint lanes, uint env, const Surface8* s,
+                                   float8 cos_o, Float3x8 ray_d, float8 t, Float3x8 beta,
+                                   const uint* tri, float8 pmf, float8 ux, float8 uy) {
+  LightSample8 ls = sample_triangle8(scene, tri, s->p, ux, uy);
+  const int8 sky = ((int8)(1, 2, 4, 8, 16, 32, 64, 128) & (int8)(env)) != 0;
+  if (env != 0u) { /* env_sample without a map */
+    const float3 bg = scene->desc->background.xyz;
+    ls.wi = select3x8(ls.wi, env_sample_uniform8(ux, uy), sky);
+    ls.li = select3x8(ls.li, (Float3x8){bg.x, bg.y, bg.z}, sky);
+    ls.pdf = select(ls.pdf, (float8)(1.0f / (4.0f * WP_PI)), sky);
+    ls.dist = select(ls.dist, (float8)(INFINITY), sky);
+  }
+  ls.pdf *= pmf;
+  float8 e_pdf;
+  const Float3x8 f = bsdf_eval8(s, cos_o, ls.wi, &e_pdf);
+  const float8 w = mis_weight_light8(ls.pdf, e_pdf);
+  const float8 k = fabs(dot3x8(s->ns, ls.wi)) * w / ls.pdf;
+  const Float3x8 c = {beta.x * f.x * ls.li.x * k, beta.y * f.y * ls.li.y * k,
+                      beta.z * f.z * ls.li.z * k};
+  const int8 lit = ls.pdf > 0.0f, finite = finite3x8(c);
+  const int8 ray = lit && finite && max3x8(c) > 0.0f;
+  uint rays = 0u;
+#pragma unroll
+  for (int i = 0; i < 8; ++i) {
+    if (!((lanes >> i) & 1u)) continue;
+    if (lane_set(lit, i) && !lane_set(finite, i)) count_nonfinite(queues);
+    if (lane_set(ray, i)) rays |= 1u << i;
+  }
+  if (rays == 0u) return 0u;
+  const Float3x8 o = surface_spawn8(s, ray_d, t, ls.wi);
+  const Float3x8 to = sub3x8(ls.target, o);
+  const float8 tmax = select(length3x8(to), (float8)(INFINITY), sky);
+  const Float3x8 dir = select3x8(div3x8(to, tmax), ls.wi, sky);
+#pragma unroll
+  for (int i = 0; i < 8; ++i) {
+    if (!((rays >> i) & 1u)) continue;
+    path_store_shadow_o(paths, slots[i], lane3(o, i), lane_of(tmax, i));
+    path_set_shadow_dir(paths, slots[i], lane3(dir, i));
+    path_set_shadow_radiance(paths, slots[i], lane3(c, i));
+  }
+  return rays;
+}
+#endif
 #endif
 
 #endif /* WP_INTEGRATOR_SAMPLE_LIGHTS_H */

@@ -35,6 +35,26 @@ static inline void aov_record(Paths paths, uint slot, float3 albedo, float3 norm
 }
 #endif
 
+#if WP_FEATURE_EMISSION
+/* The emission of the surface the path in `slot` hit at distance t (triangle `tri`, vertices and
+ * material tv, of instance `inst`; `front`: its front side; ng: its geometric normal on the ray's
+ * side), seen through throughput beta along ray_d, sampled with pdf bsdf_pdf: the front side
+ * emits, the back side too where the material is double-sided (lights.h). Also for
+ * shade_packet.h. */
+static inline void add_hit_emission(const SceneView* scene, Paths paths, uint slot, uint inst,
+                                    uint tri, uint4 tv, float t, float3 beta, float bsdf_pdf,
+                                    float3 ray_d, bool front, float3 ng) {
+  if (!front && !(scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) return;
+  const float3 le = material_emission(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot));
+  if (!(max3(le) > 0.0f)) return;
+  /* Seen from the vertex that sampled the ray: panes passed on the way add their distance. */
+  const float dist = t + path_pane_distance(paths, slot);
+  const float p_light = triangle_light_pdf(scene, inst, tri, dist, dot(ng, ray_d));
+  path_set_radiance(
+      paths, slot, path_radiance(paths, slot) + beta * le * mis_weight_bsdf_hit(bsdf_pdf, p_light));
+}
+#endif
+
 /* The hit of the path in `slot`: a miss adds the environment's radiance; a hit adds the surface's
  * emission and resolves the material into *s. True when the path goes on to scatter at *s (not
  * unlit, fewer than max_depth scattering events so far). */
@@ -92,18 +112,7 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   }
 #endif
 #if WP_FEATURE_EMISSION
-  if (front || (scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) {
-    const float3 le =
-        material_emission(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot));
-    if (max3(le) > 0.0f) {
-      /* Seen from the vertex that sampled the ray: panes passed on the way add their distance. */
-      const float dist = t + path_pane_distance(paths, slot);
-      const float p_light = triangle_light_pdf(scene, inst, tri, dist, dot(s->ng, ray_d));
-      path_set_radiance(
-          paths, slot,
-          path_radiance(paths, slot) + beta * le * mis_weight_bsdf_hit(bsdf_pdf, p_light));
-    }
-  }
+  add_hit_emission(scene, paths, slot, inst, tri, tv, t, beta, bsdf_pdf, ray_d, front, s->ng);
 #endif
 #if WP_FEATURE_UNLIT
   if (s->flags & WP_SURF_UNLIT) { /* shows its colour as emitted radiance; nothing scatters */

@@ -1,0 +1,136 @@
+/* The fused shading stage for eight paths per work-item, float8 lanes being paths, in programs
+ * whose every scattering surface is untextured and Lambertian (WP_SHADE_PACKET: the host's choice
+ * on PoCL's CPU devices, which run a kernel's work-items one after another, so SIMD across paths
+ * has to be written out). Each path gets exactly what shade.cl's single-path body gives it: a
+ * miss, emission, a light other than a triangle and roulette go through the same functions lane
+ * by lane; the surface, a triangle light's sample and the next ray through their twins of eight
+ * lanes, each beside its original (common.h says why) and computing the same expressions. */
+#ifndef WP_INTEGRATOR_SHADE_PACKET_H
+#define WP_INTEGRATOR_SHADE_PACKET_H
+
+#include "integrator/roulette_compact.h"
+#include "integrator/sample_bsdf.h"
+#include "integrator/sample_lights.h"
+#include "integrator/shade_surface.h"
+
+#if WP_SHADE_PACKET
+#if WP_FEATURE_GLOSSY || WP_FEATURE_TEXTURES || WP_FEATURE_TEXTURE_LOD ||                          \
+    WP_FEATURE_NORMAL_MAPS || WP_FEATURE_VERTEX_COLORS || WP_FEATURE_ALPHA || WP_FEATURE_UNLIT ||  \
+    WP_FEATURE_TRANSMISSION || WP_FEATURE_VOLUME || WP_BSDF_EXTENSIONS || WP_FEATURE_DISPERSION || \
+    WP_BVH_INSTANCES || WP_AOV
+#error "WP_SHADE_PACKET: programs of untextured Lambertian surfaces without instances or AOVs"
+#endif
+
+#define WP_SHADE_LANES 8
+
+/* The shading of the paths in entries [first, first + WP_SHADE_LANES) of launch.queue_in, as
+ * shade.cl's body shades each: their slots, and in bit i of *shadow and *survives whether path i
+ * has a shadow ray and a next ray. Returns how many entries there were. Lanes without a path to
+ * scatter compute with another lane's numbers, and their results are dropped. */
+WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues, Launch launch,
+                             uint first, uint* slots, uint* shadow, uint* survives) {
+  *shadow = 0u, *survives = 0u;
+  for (uint i = 0u; i < WP_SHADE_LANES; ++i) {
+    uint ahead;
+    if (prefetch_slot(queues, launch.queue_in, first + i, &ahead)) shade_prefetch(paths, ahead);
+  }
+  const int n = queue_get_run(queues, launch.queue_in, first, WP_SHADE_LANES, slots);
+  if (n == 0) return 0;
+  /* The hits; a miss is shade_hit's alone. */
+  uint hits = 0u, first_hit = 0u;
+  for (int i = n - 1; i >= 0; --i) {
+    if (path_hit_t(paths, slots[i]) < INFINITY) {
+      hits |= 1u << i, first_hit = (uint)i;
+    } else {
+      Surface unused;
+      (void)shade_hit(scene, paths, launch, slots[i], &unused);
+    }
+  }
+  if (hits == 0u) return n;
+  /* From here on every lane holds a hit: its own, or the first one's. */
+  uint sl[WP_SHADE_LANES];
+  float4 h[WP_SHADE_LANES], d[WP_SHADE_LANES], b[WP_SHADE_LANES];
+  float8 r[WP_SHADE_LANES];
+#pragma unroll
+  for (int i = 0; i < WP_SHADE_LANES; ++i) {
+    sl[i] = slots[(hits >> i) & 1u ? i : (int)first_hit];
+    h[i] = paths.hit[sl[i]], d[i] = paths.ray_d[sl[i]], b[i] = paths.throughput[sl[i]];
+  }
+#pragma nounroll
+  for (int i = 0; i < WP_SHADE_LANES; ++i) /* bounce_random's numbers (shade.cl) */
+    r[i] = rng_bounce(path_rng(paths, sl[i], launch));
+  float8 t, hu, hv, tri_bits, pane, bsdf_pdf;
+  transpose4x8(h, &t, &hu, &hv, &tri_bits);
+  Float3x8 ray_d, beta;
+  transpose4x8(d, &ray_d.x, &ray_d.y, &ray_d.z, &pane);
+  transpose4x8(b, &beta.x, &beta.y, &beta.z, &bsdf_pdf);
+  /* The numbers by their use (bounce_random): lanes of r[i] are a path's, here a use's. */
+  float8 light_pick, light_u, light_v, bsdf_u, bsdf_v, roulette_u;
+  {
+    float4 lo[WP_SHADE_LANES], hi[WP_SHADE_LANES];
+#pragma unroll
+    for (int i = 0; i < WP_SHADE_LANES; ++i) lo[i] = r[i].lo, hi[i] = r[i].hi;
+    float8 lobe, unused;
+    transpose4x8(lo, &light_pick, &light_u, &lobe, &bsdf_u);
+    transpose4x8(hi, &roulette_u, &light_v, &bsdf_v, &unused);
+  }
+  uint tri[WP_SHADE_LANES];
+  vstore8(as_uint8(tri_bits), 0, tri);
+  uint4 tv[WP_SHADE_LANES];
+  const Surface8 s = resolve_surface8(scene, tri, hu, hv, ray_d, tv);
+  /* Emission (shade_hit), and the paths that scatter: fewer than max_depth events so far. */
+  uint go = 0u;
+  for (int i = 0; i < n; ++i) {
+    if (!((hits >> i) & 1u)) continue;
+#if WP_FEATURE_EMISSION
+    add_hit_emission(scene, paths, slots[i], WP_NO_INSTANCE, tri[i], tv[i], lane_of(t, i),
+                     lane3(beta, i), lane_of(bsdf_pdf, i), lane3(ray_d, i), lane_set(s.front, i),
+                     lane3(s.ng, i));
+#endif
+    if (path_bounce(paths, slots[i]) < launch.max_depth) go |= 1u << i;
+  }
+  if (go == 0u) return n;
+  const float8 cos_o = dot3x8(s.ns, neg3x8(ray_d)); /* bsdf_view */
+#if WP_STRATEGY != WP_STRATEGY_BSDF
+  if (scene->desc->light_count != 0u) {
+    /* The light each path picks (sample_light): a triangle's point in the lanes, any other light
+     * by sample_light_ray itself. */
+    uint ltri[WP_SHADE_LANES], lanes = 0u, env = 0u;
+    float pmf[WP_SHADE_LANES], lu[WP_SHADE_LANES];
+    const bool reuse = scene->desc->light_count <= WP_LIGHT_PICK_REUSE_MAX;
+    for (int i = 0; i < WP_SHADE_LANES; ++i) {
+      float rest;
+      const uint l = pick_light(scene, lane_of(reuse ? light_u : light_pick, i), &pmf[i], &rest);
+      const uint4 meta = scene->lights[l].meta;
+      const bool triangle = meta.x == WP_LIGHT_TRIANGLE;
+      ltri[i] = triangle ? meta.y : tri[i];
+      lu[i] = reuse ? rest : lane_of(light_u, i);
+      if (!((go >> i) & 1u)) continue;
+      if (triangle) {
+        lanes |= 1u << i;
+      } else if (meta.x == WP_LIGHT_ENVIRONMENT &&
+                 !(WP_FEATURE_ENVIRONMENT && scene->desc->env_width > 0u)) {
+        lanes |= 1u << i, env |= 1u << i;
+      } else {
+        const Surface one = surface_lane(scene, &s, tv[i], i);
+        const BsdfView v = {lane_of(cos_o, i)};
+        BounceRandom u;
+        bounce_random_of(r[i], &u);
+        if (sample_light_ray(scene, paths, queues, slots[i], &one, &v, lane_of(t, i), &u))
+          *shadow |= 1u << i;
+      }
+    }
+    if (lanes != 0u)
+      *shadow |= sample_light_ray8(scene, paths, queues, slots, lanes, env, &s, cos_o, ray_d, t,
+                                   beta, ltri, vload8(0, pmf), vload8(0, lu), light_v);
+  }
+#endif
+  sample_next_ray8(paths, queues, slots, go, &s, cos_o, ray_d, t, beta, bsdf_u, bsdf_v);
+  for (int i = 0; i < n; ++i)
+    if ((go >> i) & 1u && roulette(paths, queues, launch, slots[i], lane_of(roulette_u, i)))
+      *survives |= 1u << i;
+  return n;
+}
+#endif
+
+#endif /* WP_INTEGRATOR_SHADE_PACKET_H */
