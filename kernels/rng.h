@@ -423,6 +423,70 @@ static inline __attribute__((always_inline)) float8 rng_bounce(Rng r) {
   return rng_float8(rng_reverse_bits8(rng_nested_permute8(digits, key)));
 }
 
+#if WP_SHADE_PACKET
+/* A bounce's numbers for eight paths (shade_packet.h), lanes being paths: pixel, sample and
+ * bounce per lane, seed the render's. What rng_bounce gives path i in its lane j is here lane i
+ * of the number for use j -- the same bits, integer arithmetic throughout -- for the uses the
+ * Lambertian shading has: the light pick (u[0]), the light point (u[1], u[2]), the BSDF direction
+ * (u[3], u[4]) and roulette (u[5]); not the lobe choice. */
+typedef struct RngLanes {
+  uint8 pixel, sample, bounce;
+  uint seed;
+} RngLanes;
+
+/* rng_group_seed of group `group` in every lane. */
+static inline __attribute__((always_inline)) uint8 rng_group_seed_lanes(RngLanes r, uint8 group) {
+  return wp_hash8(wp_hash8(r.bounce * WP_DIMS_PER_BOUNCE + group + wp_hash(r.seed)) ^ r.pixel);
+}
+
+/* A pair of numbers (rng_get2's) of group `group`, its order's pair `pair` in each lane; with
+ * one_d only the first (rng_get's for a one-dimensional group of pair 0). */
+static inline __attribute__((always_inline)) void rng_pair_lanes(RngLanes r, uint8 group,
+                                                                 uint8 pair, bool one_d, float8* u,
+                                                                 float8* v) {
+  const uint8 seed = rng_group_seed_lanes(r, group);
+  const uint8 index = rng_owen8(r.sample, seed);
+  uint8 dx = index, dy = rng_taylor_shift8(index);
+  if (any(pair != 0u)) {
+    uint x[8], y[8], ix[8], p[8];
+    vstore8(dx, 0, x), vstore8(dy, 0, y), vstore8(index, 0, ix), vstore8(pair, 0, p);
+    for (int i = 0; i < 8; ++i)
+      if (p[i] != 0u) {
+        const uint2 d = rng_sobol_pair_digits(ix[i], p[i]);
+        x[i] = d.x, y[i] = d.y;
+      }
+    dx = vload8(0, x), dy = vload8(0, y);
+  }
+  *u = rng_float8(rng_reverse_bits8(
+      rng_nested_permute8(dx, wp_hash8(seed ^ (WP_KEY_FIRST + pair * WP_PAIR_KEY_STEP)))));
+  if (!one_d)
+    *v = rng_float8(rng_reverse_bits8(
+        rng_nested_permute8(dy, wp_hash8(seed ^ (WP_KEY_SECOND + pair * WP_PAIR_KEY_STEP)))));
+}
+
+static inline __attribute__((always_inline)) void rng_bounce_lanes(RngLanes r, float8* u) {
+  float8 unused;
+  const uint8 zero = (uint8)(0u);
+  rng_pair_lanes(r, (uint8)(WP_DIM_LIGHT_PICK), zero, true, &u[0], &unused);
+  rng_pair_lanes(r, (uint8)(WP_DIM_ROULETTE), zero, true, &u[5], &unused);
+  /* rng_pair_source, lane by lane */
+  uint8 light_group = (uint8)(WP_DIM_LIGHT_U), light_pair = zero;
+  uint8 bsdf_group = (uint8)(WP_DIM_BSDF_U), bsdf_pair = zero;
+#if WP_CHAIN_PAIRS
+  const int8 odd = (r.bounce & 1u) != 0u, first = r.bounce == 0u;
+  light_group = select(select((uint8)(WP_DIM_BSDF_U - 2u * WP_DIMS_PER_BOUNCE),
+                              (uint8)(WP_DIM_BSDF_U - WP_DIMS_PER_BOUNCE), as_uint8(odd)),
+                       (uint8)(WP_DIM_PIXEL_X), as_uint8(first));
+  light_pair =
+      select(select((uint8)(3u), (uint8)(2u), as_uint8(odd)), (uint8)(1u), as_uint8(first));
+  bsdf_group = select(bsdf_group, (uint8)(WP_DIM_BSDF_U - WP_DIMS_PER_BOUNCE), as_uint8(odd));
+  bsdf_pair = select(zero, (uint8)(1u), as_uint8(odd));
+#endif
+  rng_pair_lanes(r, light_group, light_pair, false, &u[1], &u[2]);
+  rng_pair_lanes(r, bsdf_group, bsdf_pair, false, &u[3], &u[4]);
+}
+#endif
+
 #else
 
 static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {

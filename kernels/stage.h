@@ -69,16 +69,13 @@ typedef struct BounceRandom {
 
 /* Written through a pointer rather than returned: an always-inlined function returning a struct
  * leaves llvm.experimental.noalias.scope.decl behind, which Oclgrind cannot run. */
-static inline __attribute__((always_inline)) void bounce_random_of(float8 v, BounceRandom* u) {
+static inline __attribute__((always_inline)) void bounce_random(Rng r, BounceRandom* u) {
+  const float8 v = rng_bounce(r);
   u->light_pick = v.s0;
   u->light_uv = (float2)(v.s1, v.s5);
   u->lobe = v.s2;
   u->bsdf_uv = (float2)(v.s3, v.s6);
   u->roulette = v.s4;
-}
-/* The bounce's numbers of the path whose Rng is r: rng_bounce's lanes by their use. */
-static inline __attribute__((always_inline)) void bounce_random(Rng r, BounceRandom* u) {
-  bounce_random_of(rng_bounce(r), u);
 }
 
 #endif /* WP_STAGE_H */

@@ -651,10 +651,10 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
            {Sampler::kSobol, Strategy::kMis, 1000},
            {Sampler::kSobol, Strategy::kNee, 0},
            {Sampler::kSobol, Strategy::kBsdf, 1000},
+           {Sampler::kSobolPadded, Strategy::kMis, 1000},
            {Sampler::kIndependent, Strategy::kMis, 0}}) {
-    SCOPED_TRACE(std::string(sampler == wp::Sampler::kSobol ? "sobol" : "independent") +
-                 ", strategy " + std::to_string(static_cast<int>(strategy)) + ", wave " +
-                 std::to_string(wave));
+    SCOPED_TRACE("sampler " + std::to_string(static_cast<int>(sampler)) + ", strategy " +
+                 std::to_string(static_cast<int>(strategy)) + ", wave " + std::to_string(wave));
     wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
     st.sampler = sampler;
     st.strategy = strategy;

@@ -50,30 +50,43 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
   /* From here on every lane holds a hit: its own, or the first one's. */
   uint sl[WP_SHADE_LANES];
   float4 h[WP_SHADE_LANES], d[WP_SHADE_LANES], b[WP_SHADE_LANES];
-  float8 r[WP_SHADE_LANES];
 #pragma unroll
   for (int i = 0; i < WP_SHADE_LANES; ++i) {
     sl[i] = slots[(hits >> i) & 1u ? i : (int)first_hit];
     h[i] = paths.hit[sl[i]], d[i] = paths.ray_d[sl[i]], b[i] = paths.throughput[sl[i]];
   }
-#pragma nounroll
-  for (int i = 0; i < WP_SHADE_LANES; ++i) /* bounce_random's numbers (shade.cl) */
-    r[i] = rng_bounce(path_rng(paths, sl[i], launch));
   float8 t, hu, hv, tri_bits, pane, bsdf_pdf;
   transpose4x8(h, &t, &hu, &hv, &tri_bits);
   Float3x8 ray_d, beta;
   transpose4x8(d, &ray_d.x, &ray_d.y, &ray_d.z, &pane);
   transpose4x8(b, &beta.x, &beta.y, &beta.z, &bsdf_pdf);
-  /* The numbers by their use (bounce_random): lanes of r[i] are a path's, here a use's. */
-  float8 light_pick, light_u, light_v, bsdf_u, bsdf_v, roulette_u;
+  /* The bounce's numbers (bounce_random), by their use: light pick, light point, direction,
+   * roulette. */
+  float8 u[6];
+#if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
+  {
+    uint px[WP_SHADE_LANES], sa[WP_SHADE_LANES], bo[WP_SHADE_LANES];
+    for (int i = 0; i < WP_SHADE_LANES; ++i)
+      px[i] = path_pixel(launch, sl[i]), sa[i] = path_sample(launch, sl[i]),
+      bo[i] = path_bounce(paths, sl[i]);
+    const RngLanes r = {vload8(0, px), vload8(0, sa), vload8(0, bo), launch.seed};
+    rng_bounce_lanes(r, u);
+  }
+#else
   {
     float4 lo[WP_SHADE_LANES], hi[WP_SHADE_LANES];
-#pragma unroll
-    for (int i = 0; i < WP_SHADE_LANES; ++i) lo[i] = r[i].lo, hi[i] = r[i].hi;
+#pragma nounroll
+    for (int i = 0; i < WP_SHADE_LANES; ++i) {
+      const float8 v = rng_bounce(path_rng(paths, sl[i], launch));
+      lo[i] = v.lo, hi[i] = v.hi;
+    }
     float8 lobe, unused;
-    transpose4x8(lo, &light_pick, &light_u, &lobe, &bsdf_u);
-    transpose4x8(hi, &roulette_u, &light_v, &bsdf_v, &unused);
+    transpose4x8(lo, &u[0], &u[1], &lobe, &u[3]);
+    transpose4x8(hi, &u[5], &u[2], &u[4], &unused);
   }
+#endif
+  const float8 light_pick = u[0], light_u = u[1], light_v = u[2], bsdf_u = u[3], bsdf_v = u[4],
+               roulette_u = u[5];
   uint tri[WP_SHADE_LANES];
   vstore8(as_uint8(tri_bits), 0, tri);
   uint4 tv[WP_SHADE_LANES];
@@ -114,9 +127,10 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
       } else {
         const Surface one = surface_lane(scene, &s, tv[i], i);
         const BsdfView v = {lane_of(cos_o, i)};
-        BounceRandom u;
-        bounce_random_of(r[i], &u);
-        if (sample_light_ray(scene, paths, queues, slots[i], &one, &v, lane_of(t, i), &u))
+        BounceRandom one_u; /* what sample_light_ray reads of it */
+        one_u.light_pick = lane_of(light_pick, i);
+        one_u.light_uv = (float2)(lane_of(light_u, i), lane_of(light_v, i));
+        if (sample_light_ray(scene, paths, queues, slots[i], &one, &v, lane_of(t, i), &one_u))
           *shadow |= 1u << i;
       }
     }
