@@ -81,7 +81,9 @@ WP_LANES_FN float lane_of(float8 v, int i) {
   return a[i];
 }
 WP_LANES_FN bool lane_set(int8 mask, int i) {
-  return lane_of(as_float8(mask), i) != 0.0f;
+  int a[8];
+  vstore8(mask, 0, a);
+  return a[i] != 0;
 }
 WP_LANES_FN float3 lane3(Float3x8 v, int i) {
   return (float3)(lane_of(v.x, i), lane_of(v.y, i), lane_of(v.z, i));

@@ -574,8 +574,8 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
     const auto& reference = first.image.rgb;
     // The scene has no instances, alpha or transmission, so on PoCL's CPU devices (the wide BVH)
     // the default traces shadow rays and closest-hit rays in packets: the comparisons below do
-    // test both traversals. (Closest-hit rays take turns of packets and single rays per bounce
-    // until one is found faster, Wavefront::packet_mode: a render of several waves uses both.)
+    // test both traversals. (Both take turns of packets and single rays per bounce until one is
+    // found faster, Wavefront::packet_mode: a render of several waves uses both.)
     const wp::DeviceEntry& device = runtime_->device();
     if (!device.gpu && device.platform_name == "Portable Computing Language") {
       EXPECT_NE(first.report.build_options.find("-D WP_SHADOW_PACKET=1"), std::string::npos)
@@ -611,13 +611,18 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
       if (!packets) {
         EXPECT_EQ(rendered.report.closest_packet, 1u);
         EXPECT_TRUE(rendered.report.closest_packets.empty());
+        EXPECT_EQ(rendered.report.shadow_packet, 1u);
+        EXPECT_TRUE(rendered.report.shadow_packets.empty());
       } else if (rendered.report.closest_packet > 1 && wave == 1000) {
-        // Several waves (the image has more pixels x samples than 1000): the camera rays of the
-        // waves after the first were timed both ways, and the report says so.
-        ASSERT_FALSE(rendered.report.closest_packets.empty());
-        const wp::PacketTiming& camera = rendered.report.closest_packets[0];
-        EXPECT_GT(camera.rays[0], 0u);
-        EXPECT_GT(camera.rays[1], 0u);
+        // Several waves (the image has more pixels x samples than 1000): the camera rays and the
+        // first shadow rays of the waves after the first were timed both ways, and the report
+        // says so.
+        for (const auto* timing :
+             {&rendered.report.closest_packets, &rendered.report.shadow_packets}) {
+          ASSERT_FALSE(timing->empty());
+          EXPECT_GT((*timing)[0].rays[0], 0u);
+          EXPECT_GT((*timing)[0].rays[1], 0u);
+        }
       }
       ASSERT_EQ(image.size(), reference.size());
       EXPECT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * sizeof(float)))

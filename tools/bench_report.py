@@ -119,7 +119,7 @@ def stage_rows(runs):
         hits = ""
         if "hit_fraction" in b and "embree_hit_fraction" in b:
             hits = f"{percent(b['hit_fraction'])} / {percent(b['embree_hit_fraction'])}"
-        if b.get("packets"):  # intersect_closest's rows: the walk a render keeps (stage_bench)
+        if b.get("packets"):  # the ray-tracing rows: the walk a render keeps (stage_bench)
             stage += " (packets)"
         rows.append("| {} | {} | {:,} | {} | {} | {} | {} | {} |".format(
             stage, bounce, int(round(b.get("rays", 0))), seconds(run_time(b)),
@@ -265,9 +265,9 @@ def report(data, source, page=None, commit=None):
                "last bounce), device time from its OpenCL profiling event. embree_ratio: our rays/s "
                "over Embree's `rtcIntersect1` / `rtcOccluded1` on the very same rays; the last "
                "column shows they are the same rays (they differ only where our kernels cull back "
-               "faces or test alpha, which Embree here does not). intersect_closest times the "
-               "walk a render would keep for those rays, eight rays per work-item where marked "
-               "(packets) and faster, else one.")
+               "faces or test alpha, which Embree here does not). intersect_closest and "
+               "trace_shadow time the walk a render would keep for those rays, eight rays per "
+               "work-item where marked (packets) and faster, else one.")
     for scene, scene_runs in scenes.items():
         out += ["", f"### {scene}", ""]
         stages = [(p, b) for p, b in scene_runs if p[0] in STAGES]

@@ -3,7 +3,7 @@
 // (untimed) before the iteration; the time is the launch's own device time from its profiling
 // event. The two ray-tracing stages
 // also trace their very rays with Embree in the same run: embree_ratio = our rays/s over Embree's.
-// intersect_closest times the walk a render would keep for the bounce (packets or single rays).
+// The two time the walk a render would keep for the bounce (packets or single rays).
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -120,22 +120,26 @@ void run_stage(benchmark::State& state, const SceneSpec& spec, Stage stage, int 
   const bool restore_each = !repeatable(stage);
   wf.restore(*job.input);
   dev::Launch params = job.params;
-  if (stage == Stage::kIntersectClosest && params.packet > 1) {
-    // As a render chooses per bounce (Wavefront::packet_mode): closest-hit rays in packets or one
-    // per work-item, whichever traces these rays faster, here over a few untimed launches of each
-    // (the kernel writes only the hit record, the same either way). packet_speedup: the single
-    // walk's time over the packets'.
-    double walk[2] = {0.0, 0.0};
+  // As a render chooses per bounce (Wavefront::packet_mode): the ray-tracing stages' rays in
+  // packets or one per work-item, whichever traces these rays faster, here over a few untimed
+  // launches of each (the kernels write the same either way: intersect_closest the hit record,
+  // trace_shadow the same radiance, which these launches add to and the timed ones go on adding
+  // to). packet_speedup: the single walk's time over the packets'.
+  dev::uint dev::Launch::*walk = stage == Stage::kIntersectClosest ? &dev::Launch::packet
+                                 : stage == Stage::kTraceShadow    ? &dev::Launch::shadow_packet
+                                                                   : nullptr;
+  if (walk && params.*walk > 1) {
+    double seconds[2] = {0.0, 0.0};
     for (int i = 0; i < 2 * kWalkChoiceLaunches; ++i) {
       dev::Launch p = params;
-      p.packet = i % 2 ? params.packet : 1u;
+      p.*walk = i % 2 ? params.*walk : 1u;
       const cl::Event e = wf.launch_stage(stage, job.launch_items, p);
       e.wait();
-      walk[i % 2] += event_seconds(e);
+      seconds[i % 2] += event_seconds(e);
     }
-    if (walk[0] <= walk[1]) params.packet = 1u;
-    state.counters["packets"] = params.packet > 1 ? 1.0 : 0.0;
-    state.counters["packet_speedup"] = walk[0] / walk[1];
+    if (seconds[0] <= seconds[1]) params.*walk = 1u;
+    state.counters["packets"] = params.*walk > 1 ? 1.0 : 0.0;
+    state.counters["packet_speedup"] = seconds[0] / seconds[1];
   }
   double total = 0;
   for (auto _ : state) {

@@ -318,8 +318,8 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
                 "where they make renders faster; the same image either way)");
   app->add_flag("--no-shadow-packets", cli.no_shadow_packets,
                 "Trace each shadow ray on its own (by default PoCL's CPU devices trace them eight "
-                "to a work-item where they are plain any-hit queries: faster on small scenes; the "
-                "same image either way)");
+                "to a work-item where they are plain any-hit queries, at each bounce where the "
+                "first waves timed that faster; the same image either way)");
   app->add_flag("--no-closest-packets", cli.no_closest_packets,
                 "Trace each closest-hit ray on its own (by default PoCL's CPU devices trace them "
                 "eight to a work-item in scenes without instances or alpha; the same image either "

@@ -443,6 +443,8 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
   r.stages = wavefront.stage_times();
   r.closest_packet = wavefront.closest_packet();
   r.closest_packets = wavefront.packet_timing();
+  r.shadow_packet = wavefront.shadow_packet();
+  r.shadow_packets = wavefront.shadow_packet_timing();
   out.film = passes.film();
   if (options.checkpoint) {
     options.checkpoint(out.film);

@@ -60,6 +60,8 @@ struct RenderReport {
   // index traced its closest-hit rays (Wavefront::closest_packet, packet_timing).
   std::uint32_t closest_packet = 1;
   std::vector<PacketTiming> closest_packets;
+  std::uint32_t shadow_packet = 1;  // the same for shadow rays
+  std::vector<PacketTiming> shadow_packets;
   // The film holds samples [settings.sample_begin, sample_end): all requested, or fewer when the
   // passes stopped early (`stop`).
   std::uint32_t sample_end = 0;

@@ -88,17 +88,20 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
     << ",\"scene_buffers\":" << r.scene_buffers << ",\"ranks\":" << r.ranks << ",\"outputs\":[";
   for (std::size_t i = 0; i < outputs.size(); ++i) o << (i ? "," : "") << json_string(outputs[i]);
   o << "]";
-  o << ",\"closest_packets\":";
-  if (r.closest_packet <= 1) {
-    o << "null";
-  } else {
-    // Per bounce index: the walk kept and what each cost per ray while it was timed.
+  // Per bounce index: the walk kept and what each cost per ray while it was timed.
+  const auto packets = [&o](const char* key, std::uint32_t packet,
+                            const std::vector<PacketTiming>& timing) {
+    o << ",\"" << key << "\":";
+    if (packet <= 1) {
+      o << "null";
+      return;
+    }
     const auto per_ray = [](const PacketTiming& t, int m) {
       return t.rays[m] ? num(t.seconds[m] * 1e9 / static_cast<double>(t.rays[m])) : "null";
     };
     o << "[";
-    for (std::size_t b = 0; b < r.closest_packets.size(); ++b) {
-      const PacketTiming& t = r.closest_packets[b];
+    for (std::size_t b = 0; b < timing.size(); ++b) {
+      const PacketTiming& t = timing[b];
       o << (b ? "," : "") << "{\"bounce\":" << b << ",\"choice\":"
         << (t.choice < 0    ? "\"timing\""
             : t.choice == 1 ? "\"packets\""
@@ -107,7 +110,9 @@ std::string report_json(const RenderSettings& s, const RenderReport& r, double l
         << ",\"timed_rays\":[" << t.rays[0] << "," << t.rays[1] << "]}";
     }
     o << "]";
-  }
+  };
+  packets("closest_packets", r.closest_packet, r.closest_packets);
+  packets("shadow_packets", r.shadow_packet, r.shadow_packets);
   if (s.profile) {
     o << ",\"stage_seconds\":{";
     for (int i = 0; i < kStageCount; ++i)

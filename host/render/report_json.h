@@ -27,7 +27,8 @@ std::map<std::string, std::string> film_exr_attributes(const FilmInfo& film);
 // scene_buffers, ranks (processes of an MPI job), outputs, closest_packets (null where the
 // program has no closest-hit packets, else per bounce index, the last for every deeper bounce
 // too: {bounce, choice "packets" | "single" | "timing", single_ns_per_ray, packet_ns_per_ray,
-// timed_rays [single, packets]}; a bounce index not listed traced single rays), and with
+// timed_rays [single, packets]}; a bounce index not listed traced single rays), shadow_packets
+// (the same for shadow rays), and with
 // profiling stage_seconds {stage: seconds}.
 std::string report_json(const RenderSettings& settings, const RenderReport& report,
                         double load_seconds, double total_seconds,

@@ -278,7 +278,9 @@ void Wavefront::prime_kernels() {
 
 cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
   if (items == 0) return cl::Event();
-  if (stage == Stage::kTraceShadow) items = (items + shadow_packet_ - 1) / shadow_packet_;
+  if (stage == Stage::kTraceShadow) last_shadow_rays_ = items;  // its queue's exact length
+  if (stage == Stage::kTraceShadow && shadow_packet_ > 1 && params.shadow_packet > 1)
+    items = (items + shadow_packet_ - 1) / shadow_packet_;
   if (stage == Stage::kShade) items = (items + shade_packet_ - 1) / shade_packet_;
   if (stage == Stage::kIntersectClosest && closest_packet_ > 1 && params.packet > 1)
     items = (items + closest_packet_ - 1) / closest_packet_;
@@ -295,6 +297,7 @@ cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch&
   }
   if (settings_.profile) pending_events_.emplace_back(stage, event);
   if (stage == Stage::kIntersectClosest) last_intersect_ = event;
+  if (stage == Stage::kTraceShadow) last_shadow_ = event;
   return event;
 }
 
@@ -329,8 +332,9 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   p.max_depth = static_cast<dev::uint>(settings_.max_depth);
   p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
   p.rr_threshold = settings_.rr_threshold;
-  // Closest-hit packets where the program has them; run_wave picks per bounce.
+  // Packets where the program has them; run_wave picks per bounce.
   p.packet = closest_packet_;
+  p.shadow_packet = shadow_packet_;
   return p;
 }
 
@@ -341,28 +345,35 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
 // single rays until each has traced kPacketTimingRays rays or been launched kPacketTimingLaunches
 // times (deep bounces trace few rays), then keeps the faster per ray; the first wave, slower for
 // a cold start whichever it uses, is not timed. The image does not depend on the choice (the
-// walks give every ray the same hit), only the time.
+// walks give every ray the same hit), only the time. Shadow-ray packets likewise, timed apart:
+// they pay on the Cornell box and cost on glossy models, whose shadow rays part (MetalRoughSpheres'
+// bounce 1: 0.25 of Embree's rays/s in packets; docs/performance.md, "Shadow rays in packets of
+// eight").
 constexpr std::uint64_t kPacketTimingRays = 1u << 17;
 constexpr int kPacketTimingLaunches = 2;
 constexpr std::size_t kPacketTimingBounces = 8;  // deeper bounces share the last one's choice
 
-int Wavefront::packet_mode(std::size_t bounce) const {
-  if (closest_packet_ <= 1) return 0;
+int Wavefront::packet_mode(const std::vector<PacketTiming>& timing, std::uint32_t packet,
+                           std::size_t bounce) const {
+  if (packet <= 1) return 0;
   const std::size_t b = std::min(bounce, kPacketTimingBounces - 1);
-  if (b >= packet_timing_.size()) return 0;
-  const PacketTiming& t = packet_timing_[b];
+  if (b >= timing.size()) return 0;
+  const PacketTiming& t = timing[b];
   if (t.choice >= 0) return t.choice;
   return t.launches[1] < t.launches[0] ? 1 : 0;
 }
 
-void Wavefront::time_packets(std::size_t bounce, int mode, std::uint32_t rays) {
-  if (closest_packet_ <= 1 || rays == 0 || waves_run_ == 0 || last_intersect_() == nullptr) return;
+void Wavefront::time_packets(std::vector<PacketTiming>& timing, std::uint32_t packet,
+                             const cl::Event& event, std::size_t bounce, int mode,
+                             std::uint32_t rays) {
+  if (packet <= 1 || rays == 0 || waves_run_ == 0 || event() == nullptr) return;
   const std::size_t b = std::min(bounce, kPacketTimingBounces - 1);
-  if (packet_timing_.size() <= b) packet_timing_.resize(b + 1);
-  PacketTiming& t = packet_timing_[b];
+  if (timing.size() <= b) timing.resize(b + 1);
+  PacketTiming& t = timing[b];
   if (t.choice >= 0) return;
-  const auto start = last_intersect_.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-  const auto end = last_intersect_.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  event.wait();  // trace_shadow runs after the bounce's read-back: it may still be running
+  const auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  const auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
   t.seconds[mode] += static_cast<double>(end - start) * 1e-9;
   t.rays[mode] += rays;
   t.launches[mode] += 1;
@@ -383,11 +394,15 @@ void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::u
   std::size_t bounce = 0;
   for (std::uint32_t rays = p.path_count; rays > 0; ++bounce) {
     rays_traced_ += rays;
-    const int mode = packet_mode(bounce);
+    const int mode = packet_mode(packet_timing_, closest_packet_, bounce);
+    const int shadow_mode = packet_mode(shadow_timing_, shadow_packet_, bounce);
     p.packet = mode == 1 ? closest_packet_ : 1u;
+    p.shadow_packet = shadow_mode == 1 ? shadow_packet_ : 1u;
     const std::uint32_t traced = rays;
     rays = run_bounce(p, rays);
-    time_packets(bounce, mode, traced);
+    time_packets(packet_timing_, closest_packet_, last_intersect_, bounce, mode, traced);
+    time_packets(shadow_timing_, shadow_packet_, last_shadow_, bounce, shadow_mode,
+                 last_shadow_rays_);
   }
   ++waves_run_;
   run_step(pipeline_.end, p, 0);
@@ -438,6 +453,7 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
   // partial host write makes Oclgrind 21.10 treat the whole counter buffer as uninitialised (see
   // allocate_state). The nonfinite counter after them is not written: it persists (so Oclgrind
   // would call it uninitialised, were count_nonfinite ever reached; it must not be).
+  last_shadow_rays_ = 0;  // launch() sets it where the bounce has shadow rays
   QueueCounts counts{};
   counts[p.queue_in] = rays;
   rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),

@@ -85,7 +85,8 @@ struct RenderSettings {
   // WP_PREFETCH); elsewhere nothing. The same image either way.
   bool prefetch = true;
   // Shadow rays traced eight to a work-item where they are plain any-hit queries, on PoCL's CPU
-  // devices with the wide BVH (kernels/traverse8_packet.h); elsewhere one each. The same image.
+  // devices with the wide BVH (kernels/traverse8_packet.h), at the bounces where the first waves
+  // timed that faster (Wavefront::packet_mode); elsewhere one each. The same image.
   bool shadow_packets = true;
   // Closest-hit rays likewise, where the program has no instances or alpha (the same walk's
   // closest-hit form: the answer does not depend on which rays share a packet).
@@ -242,6 +243,9 @@ class Wavefront {
   const std::vector<PacketTiming>& packet_timing() const { return packet_timing_; }
   // Closest-hit rays per work-item where a bounce uses packets; 1 where the program has none.
   std::uint32_t closest_packet() const { return closest_packet_; }
+  // The same for shadow rays (no packets also with transmission).
+  const std::vector<PacketTiming>& shadow_packet_timing() const { return shadow_timing_; }
+  std::uint32_t shadow_packet() const { return shadow_packet_; }
   std::string build_options() const { return options_; }
   // FNV-1a 64 of the program's source (all stage kernels, includes expanded): part of the render
   // key (render.h), so films of different kernels do not merge.
@@ -295,10 +299,13 @@ class Wavefront {
   std::uint32_t shade_packet_ = 1;    // paths per work-item of the fused shade kernel
   // Whether each bounce's closest-hit rays go in packets (closest_packet_ > 1 only): the faster
   // per ray of the two, timed on the first waves (run_wave). The same image either way.
-  std::vector<PacketTiming> packet_timing_;
-  int packet_mode(std::size_t bounce) const;
-  void time_packets(std::size_t bounce, int mode, std::uint32_t rays);
-  cl::Event last_intersect_;   // the latest intersect_closest launch, for time_packets
+  std::vector<PacketTiming> packet_timing_, shadow_timing_;  // closest-hit and shadow rays
+  int packet_mode(const std::vector<PacketTiming>& timing, std::uint32_t packet,
+                  std::size_t bounce) const;
+  void time_packets(std::vector<PacketTiming>& timing, std::uint32_t packet, const cl::Event& event,
+                    std::size_t bounce, int mode, std::uint32_t rays);
+  cl::Event last_intersect_, last_shadow_;  // the latest launches, for time_packets
+  std::uint32_t last_shadow_rays_ = 0;      // the shadow rays of the latest run_bounce
   std::size_t waves_run_ = 0;  // run_wave's count: the first wave (a cold start) is not timed
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;

@@ -55,10 +55,10 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
     sl[i] = slots[(hits >> i) & 1u ? i : (int)first_hit];
     h[i] = paths.hit[sl[i]], d[i] = paths.ray_d[sl[i]], b[i] = paths.throughput[sl[i]];
   }
-  float8 t, hu, hv, tri_bits, pane, bsdf_pdf;
+  float8 t, hu, hv, tri_bits, no_panes, bsdf_pdf; /* no transmission: no pane distances */
   transpose4x8(h, &t, &hu, &hv, &tri_bits);
   Float3x8 ray_d, beta;
-  transpose4x8(d, &ray_d.x, &ray_d.y, &ray_d.z, &pane);
+  transpose4x8(d, &ray_d.x, &ray_d.y, &ray_d.z, &no_panes);
   transpose4x8(b, &beta.x, &beta.y, &beta.z, &bsdf_pdf);
   /* The bounce's numbers (bounce_random), by their use: light pick, light point, direction,
    * roulette. */

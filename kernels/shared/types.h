@@ -203,7 +203,8 @@ typedef struct Launch {
   float rr_threshold; /* roulette ends paths whose throughput is below this (roulette_compact.h) */
   uint packet;        /* intersect_closest's rays per work-item: 1, or WP_PACKET where the program
                          has WP_CLOSEST_PACKET (traverse8_packet.h) */
-  uint pad[3];        /* to 64 bytes, a multiple of 16 on every device */
+  uint shadow_packet; /* trace_shadow's: 1, or WP_PACKET where the program has WP_SHADOW_PACKET */
+  uint pad[2];        /* to 64 bytes, a multiple of 16 on every device */
 } Launch;
 
 WP_DEV_END
