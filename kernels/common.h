@@ -88,7 +88,7 @@ WP_LANES_FN bool lane_set(int8 mask, int i) {
 WP_LANES_FN float3 lane3(Float3x8 v, int i) {
   return (float3)(lane_of(v.x, i), lane_of(v.y, i), lane_of(v.z, i));
 }
-/* Eight float4 as four float8 of their components, lane i from v[i], and back. */
+/* Eight float4 as four float8 of their components, lane i from v[i]. */
 WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, float8* w) {
   const float8 a = (float8)(v[0], v[1]), b = (float8)(v[2], v[3]);
   const float8 c = (float8)(v[4], v[5]), d = (float8)(v[6], v[7]);
@@ -96,16 +96,6 @@ WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, 
   *y = (float8)(shuffle2(a, b, (uint4)(1, 5, 9, 13)), shuffle2(c, d, (uint4)(1, 5, 9, 13)));
   *z = (float8)(shuffle2(a, b, (uint4)(2, 6, 10, 14)), shuffle2(c, d, (uint4)(2, 6, 10, 14)));
   *w = (float8)(shuffle2(a, b, (uint4)(3, 7, 11, 15)), shuffle2(c, d, (uint4)(3, 7, 11, 15)));
-}
-WP_LANES_FN void untranspose4x8(float8 x, float8 y, float8 z, float8 w, float4* v) {
-  const float8 xy0 = shuffle2(x, y, (uint8)(0, 8, 1, 9, 2, 10, 3, 11));
-  const float8 xy1 = shuffle2(x, y, (uint8)(4, 12, 5, 13, 6, 14, 7, 15));
-  const float8 zw0 = shuffle2(z, w, (uint8)(0, 8, 1, 9, 2, 10, 3, 11));
-  const float8 zw1 = shuffle2(z, w, (uint8)(4, 12, 5, 13, 6, 14, 7, 15));
-  v[0] = (float4)(xy0.s01, zw0.s01), v[1] = (float4)(xy0.s23, zw0.s23);
-  v[2] = (float4)(xy0.s45, zw0.s45), v[3] = (float4)(xy0.s67, zw0.s67);
-  v[4] = (float4)(xy1.s01, zw1.s01), v[5] = (float4)(xy1.s23, zw1.s23);
-  v[6] = (float4)(xy1.s45, zw1.s45), v[7] = (float4)(xy1.s67, zw1.s67);
 }
 /* Element index[i] of array a in lane i, as three or four float8. */
 WP_LANES_FN void gather4x8(__global const float4* a, const uint* index, float8* x, float8* y,

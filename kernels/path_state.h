@@ -28,6 +28,16 @@ static inline Paths paths_bind(__global uchar* base, PathLayout layout) {
   return p;
 }
 
+/* A whole field of one path, its lanes unnamed: path_load_<field>(paths, slot). Only for a stage
+ * that gathers the same field of several paths into vectors (integrator/shade_packet.h); the
+ * others read named lanes (below). */
+#define WP_PATH_FIELD(type, name, description)                  \
+  static inline type path_load_##name(Paths paths, uint slot) { \
+    return paths.name[slot];                                    \
+  }
+#include "shared/path_state.def"
+#undef WP_PATH_FIELD
+
 /* A setter stores its lanes alone, through a pointer to the field's scalars: no load of the lanes
  * it keeps (an assignment to a swizzle would read the whole vector first), and the stores of a
  * field's lanes, one after another, can be merged into one. OpenCL C assumes no strict aliasing

@@ -53,7 +53,8 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
 #pragma unroll
   for (int i = 0; i < WP_SHADE_LANES; ++i) {
     sl[i] = slots[(hits >> i) & 1u ? i : (int)first_hit];
-    h[i] = paths.hit[sl[i]], d[i] = paths.ray_d[sl[i]], b[i] = paths.throughput[sl[i]];
+    h[i] = path_load_hit(paths, sl[i]), d[i] = path_load_ray_d(paths, sl[i]);
+    b[i] = path_load_throughput(paths, sl[i]);
   }
   float8 t, hu, hv, tri_bits, no_panes, bsdf_pdf; /* no transmission: no pane distances */
   transpose4x8(h, &t, &hu, &hv, &tri_bits);
