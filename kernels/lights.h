@@ -49,6 +49,35 @@ static inline uint pick_light(const SceneView* scene, float u, float* pmf, float
   return chosen;
 }
 
+#if WP_SHADE_PACKET
+/* pick_light of eight numbers (common.h), the same expressions lane by lane: both of *rest's
+ * quotients are computed and the one pick_light takes is kept. */
+WP_LANES_FN uint8 pick_light8(const SceneView* scene, float8 u, float8* pmf, float8* rest) {
+  const uint n = scene->desc->light_count;
+  const float8 x = u * (float)n;
+  const uint8 i = min(convert_uint8(x), (uint8)(n - 1u)); /* truncates, as (uint)x does */
+  __global const float* table = (__global const float*)scene->light_alias;
+  uint index[8];
+  vstore8(i, 0, index);
+  float4 entry[8];
+#pragma unroll
+  for (int k = 0; k < 8; ++k) entry[k] = vload4(index[k], table);
+  float8 prob, alias, unused_pmf, unused_pad;
+  transpose4x8(entry, &prob, &alias, &unused_pmf, &unused_pad);
+  const float8 f = x - convert_float8(i);
+  const int8 own = f < prob;
+  const uint8 chosen = select(as_uint8(alias), i, as_uint8(own));
+  *rest = fmin(select((f - prob) / (1.0f - prob), f / prob, own), 0x1.fffffep-1f);
+  uint c[8];
+  vstore8(chosen, 0, c);
+  float p[8];
+#pragma unroll
+  for (int k = 0; k < 8; ++k) p[k] = scene->light_alias[c[k]].pmf;
+  *pmf = vload8(0, p);
+  return chosen;
+}
+#endif
+
 /* KHR_lights_punctual's recommended range window, applied only when a range is given. */
 static inline float range_window(float dist, float range) {
   if (range <= 0.0f) return 1.0f;

@@ -109,16 +109,15 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
   if (scene->desc->light_count != 0u) {
     /* The light each path picks (sample_light): a triangle's point in the lanes, any other light
      * by sample_light_ray itself. */
-    uint ltri[WP_SHADE_LANES], lanes = 0u, env = 0u;
-    float pmf[WP_SHADE_LANES], lu[WP_SHADE_LANES];
+    uint ltri[WP_SHADE_LANES], picked[WP_SHADE_LANES], lanes = 0u, env = 0u;
     const bool reuse = scene->desc->light_count <= WP_LIGHT_PICK_REUSE_MAX;
+    float8 pmf, rest;
+    vstore8(pick_light8(scene, reuse ? light_u : light_pick, &pmf, &rest), 0, picked);
+    const float8 lu = reuse ? rest : light_u;
     for (int i = 0; i < WP_SHADE_LANES; ++i) {
-      float rest;
-      const uint l = pick_light(scene, lane_of(reuse ? light_u : light_pick, i), &pmf[i], &rest);
-      const uint4 meta = scene->lights[l].meta;
+      const uint4 meta = scene->lights[picked[i]].meta;
       const bool triangle = meta.x == WP_LIGHT_TRIANGLE;
       ltri[i] = triangle ? meta.y : tri[i];
-      lu[i] = reuse ? rest : lane_of(light_u, i);
       if (!((go >> i) & 1u)) continue;
       if (triangle) {
         lanes |= 1u << i;
@@ -137,7 +136,7 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
     }
     if (lanes != 0u)
       *shadow |= sample_light_ray8(scene, paths, queues, slots, lanes, env, &s, cos_o, ray_d, t,
-                                   beta, ltri, vload8(0, pmf), vload8(0, lu), light_v);
+                                   beta, ltri, pmf, lu, light_v);
   }
 #endif
   sample_next_ray8(paths, queues, slots, go, &s, cos_o, ray_d, t, beta, bsdf_u, bsdf_v);
