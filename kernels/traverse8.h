@@ -12,6 +12,40 @@
 #ifndef WP_TRAVERSE8_H
 #define WP_TRAVERSE8_H
 
+/* Bit i set where lane i of `m` is set (true: all bits of the lane). On PoCL's CPU devices with
+ * AVX (WP_PREFETCH marks PoCL's CPU builds; clang defines __AVX__ for the target it compiles for)
+ * one instruction takes each lane's sign bit: LLVM 15 turns the portable version into a
+ * mask-and-or reduction of seven, and a node takes four such masks. The same bits either way
+ * (a comparison's lanes are all ones or all zeros); measured in docs/performance.md, "Lane masks
+ * in one instruction". */
+#if WP_PREFETCH && defined(__AVX__)
+static inline int lane_bits8(int8 m) {
+  return __builtin_ia32_movmskps256(as_float8(m));
+}
+#else
+static inline int lane_bits8(int8 m) {
+  const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  const int4 b4 = b.lo | b.hi;
+  const int2 b2 = b4.lo | b4.hi;
+  return b2.x | b2.y;
+}
+#endif
+
+/* Whether some lane of a comparison's mask is set: the sign bits in one instruction, as
+ * lane_bits8; PoCL's any() reduces the lanes with several. */
+static inline bool any8(int8 m) {
+  return lane_bits8(m) != 0;
+}
+#if WP_PREFETCH && defined(__AVX__)
+static inline bool any4(int4 m) {
+  return __builtin_ia32_movmskps(as_float4(m)) != 0;
+}
+#else
+static inline bool any4(int4 m) {
+  return any(m);
+}
+#endif
+
 /* The watertight test (bvh/traverse_common.h) on the 4 lanes of a block of a leaf entered at
  * `tleaf`; updates *hit with the closest lane that is closer (hit_is_closer, traverse.h), each at
  * distance max(t, tleaf). */
@@ -35,14 +69,14 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
   const int4 cull = ((flags & WP_TRI_CULL_BACKFACE) != 0) & (det < 0.0f);
   /* Most blocks end here, before the division (the same hits). */
   const int4 inside = ~mixed & (det != 0.0f) & ~cull;
-  if (!any(inside)) return false;
+  if (!any4(inside)) return false;
   const float4 inv = 1.0f / det;
   const float4 t = (u_ * (r->sz * az) + v_ * (r->sz * bz) + w_ * (r->sz * cz)) * inv;
   const float4 u = v_ * inv, v = w_ * inv;
   int4 ok = inside & (t > r->tmin);
   const float4 d = select(t, (float4)(tleaf), t < tleaf); /* the reference's fmax2 */
 #if WP_FEATURE_ALPHA
-  if (!any(ok)) return false;
+  if (!any4(ok)) return false;
   /* Lanes in order, each by the reference's rule. */
   float tl[4], ul[4], vl[4];
   int okl[4];
@@ -69,7 +103,7 @@ static inline bool block_test(const SceneView* scene, const TraceRay* r,
    * docs/performance.md, "Closest lane of a triangle block"). */
   const uint4 prim = b->prim;
   ok &= (d < hit->t) | ((d == hit->t) & (prim < hit->tri));
-  if (!any(ok)) return false;
+  if (!any4(ok)) return false;
   const float4 tm = select((float4)(INFINITY), d, ok);
   const float2 m2 = fmin(tm.lo, tm.hi);
   const float m = fmin(m2.x, m2.y);
@@ -119,25 +153,6 @@ static inline float8 min8(float8 a, float8 b) {
 static inline float8 max8(float8 a, float8 b) {
   return select(a, b, a < b);
 }
-
-/* Bit i set where lane i of `m` is set (true: all bits of the lane). On PoCL's CPU devices with
- * AVX (WP_PREFETCH marks PoCL's CPU builds; clang defines __AVX__ for the target it compiles for)
- * one instruction takes each lane's sign bit: LLVM 15 turns the portable version into a
- * mask-and-or reduction of seven, and a node takes four such masks. The same bits either way
- * (a comparison's lanes are all ones or all zeros); measured in docs/performance.md, "Lane masks
- * in one instruction". */
-#if WP_PREFETCH && defined(__AVX__)
-static inline int lane_bits8(int8 m) {
-  return __builtin_ia32_movmskps256(as_float8(m));
-}
-#else
-static inline int lane_bits8(int8 m) {
-  const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
-  const int4 b4 = b.lo | b.hi;
-  const int2 b2 = b4.lo | b4.hi;
-  return b2.x | b2.y;
-}
-#endif
 
 /* The lowest set bit's index (bits != 0). */
 static inline int lowest_bit(int bits) {

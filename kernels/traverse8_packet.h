@@ -93,7 +93,7 @@ static inline int8 packet_triangle(const PacketRays* p, __global const TriBlock4
   const uint flags = ((__global const uint*)&b->flags)[j];
   const int8 cull = (flags & WP_TRI_CULL_BACKFACE) ? det < 0.0f : (int8)(0);
   const int8 inside = live & ~mixed & (det != 0.0f) & ~cull;
-  if (!any(inside)) return (int8)(0);
+  if (!any8(inside)) return (int8)(0);
   const float8 inv = 1.0f / det;
   *t = (u_ * (p->sz * az) + v_ * (p->sz * bz) + w_ * (p->sz * cz)) * inv;
   *u = v_ * inv, *v = w_ * inv;
@@ -118,7 +118,7 @@ static inline int packet_leaf(const SceneView* scene, const PacketRays* p, int r
       if (prim[j] == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
       float8 t, u, v;
       const int8 in = packet_triangle(p, b + i, j, lane_mask8(live & ~hit), &t, &u, &v);
-      if (!any(in)) continue;
+      if (!any8(in)) continue;
       hit |= lane_bits8(in & (packet_distance(t, tleaf) < p->tmax));
       if (hit == live) return hit;
     }
@@ -202,10 +202,10 @@ static inline void packet_closest_leaf(const SceneView* scene, const PacketRays*
       if (pj == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
       float8 t, u, v;
       const int8 in = packet_triangle(p, b + i, j, live8, &t, &u, &v);
-      if (!any(in)) continue;
+      if (!any8(in)) continue;
       const float8 d = packet_distance(t, tleaf);
       const int8 take = in & ((d < h->t) | ((d == h->t) & ((uint8)(pj) < h->tri)));
-      if (!any(take)) continue;
+      if (!any8(take)) continue;
       h->t = select(h->t, d, take);
       h->u = select(h->u, u, take);
       h->v = select(h->v, v, take);
