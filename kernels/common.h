@@ -11,6 +11,44 @@
 #include "shared/types.h"
 #include "features.h"
 
+/* Bit i set where lane i of `m` is set (true: all bits of the lane). On PoCL's CPU devices with
+ * AVX (WP_PREFETCH marks PoCL's CPU builds; clang defines __AVX__ for the target it compiles for)
+ * one instruction takes each lane's sign bit: LLVM 15 turns the portable version into a
+ * mask-and-or reduction of seven, and a node takes four such masks. The same bits either way
+ * (a comparison's lanes are all ones or all zeros); measured in docs/performance.md, "Lane masks
+ * in one instruction". */
+#if WP_PREFETCH && defined(__AVX__)
+static inline int lane_bits8(int8 m) {
+  return __builtin_ia32_movmskps256(as_float8(m));
+}
+#else
+static inline int lane_bits8(int8 m) {
+  const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  const int4 b4 = b.lo | b.hi;
+  const int2 b2 = b4.lo | b4.hi;
+  return b2.x | b2.y;
+}
+#endif
+
+/* Whether some lane (all lanes) of a comparison's mask is set: the sign bits in one instruction,
+ * as lane_bits8, where PoCL's any() and all() move the mask to a vector and test the lanes' signs
+ * with shuffles and a branch per pair of lanes. */
+static inline bool any8(int8 m) {
+  return lane_bits8(m) != 0;
+}
+static inline bool all8(int8 m) {
+  return lane_bits8(m) == 0xff;
+}
+#if WP_PREFETCH && defined(__AVX__)
+static inline bool any4(int4 m) {
+  return __builtin_ia32_movmskps(as_float4(m)) != 0;
+}
+#else
+static inline bool any4(int4 m) {
+  return any(m);
+}
+#endif
+
 #define WP_PI 3.14159265358979323846f
 #define WP_INV_PI 0.31830988618379067154f
 #define WP_INF INFINITY
@@ -161,7 +199,7 @@ WP_LANES_FN float8 length3x8(Float3x8 a) {
   const float8 dd = dot3x8(a, a);
   float8 r = sqrt(dd);
   const int8 plain = plain_length(dd);
-  if (!all(plain)) {
+  if (!all8(plain)) {
     float l[8];
     vstore8(r, 0, l);
     for (int i = 0; i < 8; ++i)
@@ -175,7 +213,7 @@ WP_LANES_FN Float3x8 normalize3x8(Float3x8 a) {
   const float8 inv = 1.0f / sqrt(dd);
   Float3x8 r = {a.x * inv, a.y * inv, a.z * inv};
   const int8 plain = plain_length(dd);
-  if (!all(plain)) {
+  if (!all8(plain)) {
     float x[8], y[8], z[8];
     vstore8(r.x, 0, x), vstore8(r.y, 0, y), vstore8(r.z, 0, z);
     for (int i = 0; i < 8; ++i)

@@ -39,6 +39,7 @@
 #ifndef WP_RNG_H
 #define WP_RNG_H
 
+#include "common.h"
 #include "features.h"
 
 /* Dimensions used at each bounce. */
@@ -447,7 +448,7 @@ static inline __attribute__((always_inline)) void rng_pair_lanes(RngLanes r, uin
   const uint8 seed = rng_group_seed_lanes(r, group);
   const uint8 index = rng_owen8(r.sample, seed);
   uint8 dx = index, dy = rng_taylor_shift8(index);
-  if (any(pair != 0u)) {
+  if (any8(pair != 0u)) {
     uint x[8], y[8], ix[8], p[8];
     vstore8(dx, 0, x), vstore8(dy, 0, y), vstore8(index, 0, ix), vstore8(pair, 0, p);
     for (int i = 0; i < 8; ++i)

@@ -12,40 +12,6 @@
 #ifndef WP_TRAVERSE8_H
 #define WP_TRAVERSE8_H
 
-/* Bit i set where lane i of `m` is set (true: all bits of the lane). On PoCL's CPU devices with
- * AVX (WP_PREFETCH marks PoCL's CPU builds; clang defines __AVX__ for the target it compiles for)
- * one instruction takes each lane's sign bit: LLVM 15 turns the portable version into a
- * mask-and-or reduction of seven, and a node takes four such masks. The same bits either way
- * (a comparison's lanes are all ones or all zeros); measured in docs/performance.md, "Lane masks
- * in one instruction". */
-#if WP_PREFETCH && defined(__AVX__)
-static inline int lane_bits8(int8 m) {
-  return __builtin_ia32_movmskps256(as_float8(m));
-}
-#else
-static inline int lane_bits8(int8 m) {
-  const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
-  const int4 b4 = b.lo | b.hi;
-  const int2 b2 = b4.lo | b4.hi;
-  return b2.x | b2.y;
-}
-#endif
-
-/* Whether some lane of a comparison's mask is set: the sign bits in one instruction, as
- * lane_bits8; PoCL's any() reduces the lanes with several. */
-static inline bool any8(int8 m) {
-  return lane_bits8(m) != 0;
-}
-#if WP_PREFETCH && defined(__AVX__)
-static inline bool any4(int4 m) {
-  return __builtin_ia32_movmskps(as_float4(m)) != 0;
-}
-#else
-static inline bool any4(int4 m) {
-  return any(m);
-}
-#endif
-
 /* The watertight test (bvh/traverse_common.h) on the 4 lanes of a block of a leaf entered at
  * `tleaf`; updates *hit with the closest lane that is closer (hit_is_closer, traverse.h), each at
  * distance max(t, tleaf). */
