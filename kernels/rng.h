@@ -440,6 +440,21 @@ static inline __attribute__((always_inline)) uint8 rng_group_seed_lanes(RngLanes
   return wp_hash8(wp_hash8(r.bounce * WP_DIMS_PER_BOUNCE + group + wp_hash(r.seed)) ^ r.pixel);
 }
 
+/* rng_sobol_pair_digits of eight indices, the same pair p in every lane: the generator matrices'
+ * columns (the entries of one-bit nibbles) xored in where the index has their bit, in the lanes. */
+static inline __attribute__((always_inline)) void rng_sobol_pair_digits8(uint8 index, uint p,
+                                                                         uint8* x, uint8* y) {
+  __constant const uint(*t)[32] = wp_sobol_pairs[p - 1u];
+  uint8 dx = (uint8)(0u), dy = (uint8)(0u);
+#pragma unroll
+  for (int j = 0; j < 32; ++j) {
+    const uint8 has = as_uint8(as_int8(index << (uint)(31 - j)) >> 31);
+    dx ^= has & t[j >> 2][2 << (j & 3)];
+    dy ^= has & t[j >> 2][(2 << (j & 3)) + 1];
+  }
+  *x = dx, *y = dy;
+}
+
 /* A pair of numbers (rng_get2's) of group `group`, its order's pair `pair` in each lane; with
  * one_d only the first (rng_get's for a one-dimensional group of pair 0). */
 static inline __attribute__((always_inline)) void rng_pair_lanes(RngLanes r, uint8 group,
@@ -448,15 +463,12 @@ static inline __attribute__((always_inline)) void rng_pair_lanes(RngLanes r, uin
   const uint8 seed = rng_group_seed_lanes(r, group);
   const uint8 index = rng_owen8(r.sample, seed);
   uint8 dx = index, dy = rng_taylor_shift8(index);
-  if (any8(pair != 0u)) {
-    uint x[8], y[8], ix[8], p[8];
-    vstore8(dx, 0, x), vstore8(dy, 0, y), vstore8(index, 0, ix), vstore8(pair, 0, p);
-    for (int i = 0; i < 8; ++i)
-      if (p[i] != 0u) {
-        const uint2 d = rng_sobol_pair_digits(ix[i], p[i]);
-        x[i] = d.x, y[i] = d.y;
-      }
-    dx = vload8(0, x), dy = vload8(0, y);
+  for (uint q = 1u; q <= 3u; ++q) {
+    const int8 in = pair == q;
+    if (!any8(in)) continue;
+    uint8 x, y;
+    rng_sobol_pair_digits8(index, q, &x, &y);
+    dx = select(dx, x, as_uint8(in)), dy = select(dy, y, as_uint8(in));
   }
   *u = rng_float8(rng_reverse_bits8(
       rng_nested_permute8(dx, wp_hash8(seed ^ (WP_KEY_FIRST + pair * WP_PAIR_KEY_STEP)))));
