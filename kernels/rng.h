@@ -455,13 +455,23 @@ static inline __attribute__((always_inline)) void rng_sobol_pair_digits8(uint8 i
   *x = dx, *y = dy;
 }
 
-/* A pair of numbers (rng_get2's) of group `group`, its order's pair `pair` in each lane; with
- * one_d only the first (rng_get's for a one-dimensional group of pair 0). */
-static inline __attribute__((always_inline)) void rng_pair_lanes(RngLanes r, uint8 group,
-                                                                 uint8 pair, bool one_d, float8* u,
-                                                                 float8* v) {
+/* A group's sample order in every lane: its scramble seed and its shuffled sample index. */
+typedef struct RngOrderLanes {
+  uint8 seed, index;
+} RngOrderLanes;
+
+static inline __attribute__((always_inline)) RngOrderLanes rng_order_lanes(RngLanes r,
+                                                                           uint8 group) {
   const uint8 seed = rng_group_seed_lanes(r, group);
-  const uint8 index = rng_owen8(r.sample, seed);
+  const RngOrderLanes o = {seed, rng_owen8(r.sample, seed)};
+  return o;
+}
+
+/* A pair of numbers (rng_get2's) of the order o, its pair `pair` in each lane; with one_d only
+ * the first (rng_get's for a one-dimensional group of pair 0). */
+static inline __attribute__((always_inline)) void rng_pair_lanes(RngOrderLanes o, uint8 pair,
+                                                                 bool one_d, float8* u, float8* v) {
+  const uint8 seed = o.seed, index = o.index;
   uint8 dx = index, dy = rng_taylor_shift8(index);
   for (uint q = 1u; q <= 3u; ++q) {
     const int8 in = pair == q;
@@ -480,8 +490,8 @@ static inline __attribute__((always_inline)) void rng_pair_lanes(RngLanes r, uin
 static inline __attribute__((always_inline)) void rng_bounce_lanes(RngLanes r, float8* u) {
   float8 unused;
   const uint8 zero = (uint8)(0u);
-  rng_pair_lanes(r, (uint8)(WP_DIM_LIGHT_PICK), zero, true, &u[0], &unused);
-  rng_pair_lanes(r, (uint8)(WP_DIM_ROULETTE), zero, true, &u[5], &unused);
+  rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_LIGHT_PICK)), zero, true, &u[0], &unused);
+  rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_ROULETTE)), zero, true, &u[5], &unused);
   /* rng_pair_source, lane by lane */
   uint8 light_group = (uint8)(WP_DIM_LIGHT_U), light_pair = zero;
   uint8 bsdf_group = (uint8)(WP_DIM_BSDF_U), bsdf_pair = zero;
@@ -495,8 +505,12 @@ static inline __attribute__((always_inline)) void rng_bounce_lanes(RngLanes r, f
   bsdf_group = select(bsdf_group, (uint8)(WP_DIM_BSDF_U - WP_DIMS_PER_BOUNCE), as_uint8(odd));
   bsdf_pair = select(zero, (uint8)(1u), as_uint8(odd));
 #endif
-  rng_pair_lanes(r, light_group, light_pair, false, &u[1], &u[2]);
-  rng_pair_lanes(r, bsdf_group, bsdf_pair, false, &u[3], &u[4]);
+  /* At odd bounces both pairs take the order of the BSDF direction one bounce back. */
+  const RngOrderLanes light = rng_order_lanes(r, light_group);
+  const RngOrderLanes bsdf =
+      all8(bsdf_group == light_group) ? light : rng_order_lanes(r, bsdf_group);
+  rng_pair_lanes(light, light_pair, false, &u[1], &u[2]);
+  rng_pair_lanes(bsdf, bsdf_pair, false, &u[3], &u[4]);
 }
 #endif
 
