@@ -100,14 +100,25 @@ static inline float3 offset_origin(float3 p, float3 n, float scale) {
   return p + n * offset_distance(scale);
 }
 
+/* Always inlined: a float8 triple passed to a function kept out of line goes through memory. */
+#define WP_LANES_FN static inline __attribute__((always_inline))
+
+/* Eight float4 as four float8 of their components, lane i from v[i] (shade, ray packets). */
+WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, float8* w) {
+  const float8 a = (float8)(v[0], v[1]), b = (float8)(v[2], v[3]);
+  const float8 c = (float8)(v[4], v[5]), d = (float8)(v[6], v[7]);
+  *x = (float8)(shuffle2(a, b, (uint4)(0, 4, 8, 12)), shuffle2(c, d, (uint4)(0, 4, 8, 12)));
+  *y = (float8)(shuffle2(a, b, (uint4)(1, 5, 9, 13)), shuffle2(c, d, (uint4)(1, 5, 9, 13)));
+  *z = (float8)(shuffle2(a, b, (uint4)(2, 6, 10, 14)), shuffle2(c, d, (uint4)(2, 6, 10, 14)));
+  *w = (float8)(shuffle2(a, b, (uint4)(3, 7, 11, 15)), shuffle2(c, d, (uint4)(3, 7, 11, 15)));
+}
+
 #if WP_SHADE_PACKET
 /* Eight paths shaded at once (integrator/shade_packet.h), float8 lanes being paths. Each function
  * with a twin of eight lanes has it beside itself, written with the same expressions, so that the
  * twin rounds as it does lane by lane: the program is one translation unit in which traverse.h's
  * FP_CONTRACT OFF holds for all that follows it, so a header's fused multiply-adds depend on where
  * it is first included, and a twin in the same header shares them. */
-/* Always inlined: a float8 triple passed to a function kept out of line goes through memory. */
-#define WP_LANES_FN static inline __attribute__((always_inline))
 
 typedef struct Float3x8 {
   float8 x, y, z;
@@ -125,15 +136,6 @@ WP_LANES_FN bool lane_set(int8 mask, int i) {
 }
 WP_LANES_FN float3 lane3(Float3x8 v, int i) {
   return (float3)(lane_of(v.x, i), lane_of(v.y, i), lane_of(v.z, i));
-}
-/* Eight float4 as four float8 of their components, lane i from v[i]. */
-WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, float8* w) {
-  const float8 a = (float8)(v[0], v[1]), b = (float8)(v[2], v[3]);
-  const float8 c = (float8)(v[4], v[5]), d = (float8)(v[6], v[7]);
-  *x = (float8)(shuffle2(a, b, (uint4)(0, 4, 8, 12)), shuffle2(c, d, (uint4)(0, 4, 8, 12)));
-  *y = (float8)(shuffle2(a, b, (uint4)(1, 5, 9, 13)), shuffle2(c, d, (uint4)(1, 5, 9, 13)));
-  *z = (float8)(shuffle2(a, b, (uint4)(2, 6, 10, 14)), shuffle2(c, d, (uint4)(2, 6, 10, 14)));
-  *w = (float8)(shuffle2(a, b, (uint4)(3, 7, 11, 15)), shuffle2(c, d, (uint4)(3, 7, 11, 15)));
 }
 /* Element index[i] of array a in lane i, as three or four float8. */
 WP_LANES_FN void gather4x8(__global const float4* a, const uint* index, float8* x, float8* y,

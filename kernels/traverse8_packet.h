@@ -27,31 +27,34 @@ typedef struct PacketRays {
   float8 sx, sy, sz, o_kx, o_ky, o_kz;
 } PacketRays;
 
-/* The packet of rays r[0, n) (n <= WP_PACKET), each with maximum distance tmax[i]; lanes from n on
- * copy lane 0 and are never live. */
-static inline PacketRays packet_rays(const TraceRay* r, const float* tmax, int n) {
-  float ox[WP_PACKET], oy[WP_PACKET], oz[WP_PACKET], ix[WP_PACKET], iy[WP_PACKET], iz[WP_PACKET],
-      tmin[WP_PACKET], tm[WP_PACKET], sx[WP_PACKET], sy[WP_PACKET], sz[WP_PACKET], okx[WP_PACKET],
-      oky[WP_PACKET], okz[WP_PACKET];
-  int kx[WP_PACKET], ky[WP_PACKET], kz[WP_PACKET];
-  for (int i = 0; i < WP_PACKET; ++i) {
-    const int k = i < n ? i : 0;
-    ox[i] = r[k].ox, oy[i] = r[k].oy, oz[i] = r[k].oz;
-    ix[i] = r[k].ix, iy[i] = r[k].iy, iz[i] = r[k].iz;
-    tmin[i] = r[k].tmin, tm[i] = tmax[k];
-    kx[i] = r[k].kx, ky[i] = r[k].ky, kz[i] = r[k].kz;
-    sx[i] = r[k].sx, sy[i] = r[k].sy, sz[i] = r[k].sz;
-    okx[i] = r[k].o_kx, oky[i] = r[k].o_ky, okz[i] = r[k].o_kz;
-  }
+/* The packet of the rays with origins o[i].xyz and directions d[i].xyz, i < 8 (a caller with
+ * fewer rays repeats one), trace_ray's quantities computed in the lanes with its expressions;
+ * tmin and tmax are the caller's to set. *ow: the w components of o[i]. */
+static inline PacketRays packet_rays8(const float4* o, const float4* d, float8* ow) {
   PacketRays p;
-  p.ox = vload8(0, ox), p.oy = vload8(0, oy), p.oz = vload8(0, oz);
-  p.ix = vload8(0, ix), p.iy = vload8(0, iy), p.iz = vload8(0, iz);
-  p.tmin = vload8(0, tmin), p.tmax = vload8(0, tm);
-  const int8 ax = vload8(0, kx), ay = vload8(0, ky), az = vload8(0, kz);
-  p.kx1 = ax == 1, p.kx2 = ax == 2, p.ky1 = ay == 1, p.ky2 = ay == 2, p.kz1 = az == 1,
-  p.kz2 = az == 2;
-  p.sx = vload8(0, sx), p.sy = vload8(0, sy), p.sz = vload8(0, sz);
-  p.o_kx = vload8(0, okx), p.o_ky = vload8(0, oky), p.o_kz = vload8(0, okz);
+  float8 dx, dy, dz, unused;
+  transpose4x8(o, &p.ox, &p.oy, &p.oz, ow);
+  transpose4x8(d, &dx, &dy, &dz, &unused);
+  const float8 tiny = (float8)(1e-20f); /* safe_rcp */
+  p.ix = 1.0f / select(copysign(tiny, dx), dx, fabs(dx) > tiny);
+  p.iy = 1.0f / select(copysign(tiny, dy), dy, fabs(dy) > tiny);
+  p.iz = 1.0f / select(copysign(tiny, dz), dz, fabs(dz) > tiny);
+  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+  const int8 kz = select(select((int8)(2), (int8)(1), ay >= az),
+                         select((int8)(2), (int8)(0), ax >= az), ax >= ay);
+  const int8 kx0 = select(kz + 1, (int8)(0), kz == 2);
+  const int8 ky0 = select(kx0 + 1, (int8)(0), kx0 == 2);
+  const int8 kz1 = kz == 1, kz2 = kz == 2;
+  const float8 dkz = select(select(dx, dy, kz1), dz, kz2);
+  const int8 swap = dkz < 0.0f;
+  const int8 kx = select(kx0, ky0, swap), ky = select(ky0, kx0, swap);
+  p.kx1 = kx == 1, p.kx2 = kx == 2, p.ky1 = ky == 1, p.ky2 = ky == 2, p.kz1 = kz1, p.kz2 = kz2;
+  p.sx = select(select(dx, dy, p.kx1), dz, p.kx2) / dkz;
+  p.sy = select(select(dx, dy, p.ky1), dz, p.ky2) / dkz;
+  p.sz = 1.0f / dkz;
+  p.o_kx = select(select(p.ox, p.oy, p.kx1), p.oz, p.kx2);
+  p.o_ky = select(select(p.ox, p.oy, p.ky1), p.oz, p.ky2);
+  p.o_kz = select(select(p.ox, p.oy, kz1), p.oz, kz2);
   return p;
 }
 

@@ -35,8 +35,6 @@ WP_STAGE_FN void intersect_path(const SceneView* scene, Paths paths, Launch laun
  * as intersect_path gives each (traverse8_packet.h). */
 WP_STAGE_FN void intersect_packet(const SceneView* scene, Paths paths, Queues queues, uint queue,
                                   uint first) {
-  TraceRay r[WP_PACKET];
-  float tmax[WP_PACKET];
   uint slots[WP_PACKET];
   /* The single-ray stage's cache hints, for the entries WP_PREFETCH_AHEAD further on. */
   for (uint i = 0u; i < WP_PACKET; ++i) {
@@ -45,12 +43,13 @@ WP_STAGE_FN void intersect_packet(const SceneView* scene, Paths paths, Queues qu
   }
   const int n = queue_get_run(queues, queue, first, WP_PACKET, slots);
   if (n == 0) return;
-  for (int i = 0; i < n; ++i) {
-    r[i] = trace_ray(path_ray_origin(paths, slots[i]), path_ray_dir(paths, slots[i]),
-                     path_ray_tmin(paths, slots[i]), 0u);
-    tmax[i] = INFINITY;
+  float4 o[WP_PACKET], d[WP_PACKET];
+  for (int i = 0; i < WP_PACKET; ++i) {
+    const uint slot = slots[i < n ? i : 0];
+    o[i] = path_load_ray_o(paths, slot), d[i] = path_load_ray_d(paths, slot);
   }
-  const PacketRays p = packet_rays(r, tmax, n);
+  PacketRays p = packet_rays8(o, d, &p.tmin); /* ray_o.w: tmin */
+  p.tmax = (float8)(INFINITY);
   PacketHit h;
   packet_closest(scene, &p, (1 << n) - 1, &h);
   float t[WP_PACKET], u[WP_PACKET], v[WP_PACKET];

@@ -79,8 +79,6 @@ WP_STAGE_FN void trace_shadow_path(const SceneView* scene, Paths paths, Launch l
  * trace_shadow_path gives each (traverse8_packet.h). */
 WP_STAGE_FN void trace_shadow_packet(const SceneView* scene, Paths paths, Queues queues,
                                      uint first) {
-  TraceRay r[WP_PACKET];
-  float tmax[WP_PACKET];
   uint slots[WP_PACKET];
   /* The single-ray stage's cache hints, for the entries WP_PREFETCH_AHEAD further on. */
   for (uint i = 0u; i < WP_PACKET; ++i) {
@@ -90,12 +88,13 @@ WP_STAGE_FN void trace_shadow_packet(const SceneView* scene, Paths paths, Queues
   }
   const int n = queue_get_run(queues, WP_QUEUE_SHADOW, first, WP_PACKET, slots);
   if (n == 0) return;
-  for (int i = 0; i < n; ++i) {
-    r[i] =
-        trace_ray(path_shadow_origin(paths, slots[i]), path_shadow_dir(paths, slots[i]), 0.0f, 0u);
-    tmax[i] = path_shadow_tmax(paths, slots[i]);
+  float4 o[WP_PACKET], d[WP_PACKET];
+  for (int i = 0; i < WP_PACKET; ++i) {
+    const uint slot = slots[i < n ? i : 0];
+    o[i] = path_load_shadow_o(paths, slot), d[i] = path_load_shadow_d(paths, slot);
   }
-  const PacketRays p = packet_rays(r, tmax, n);
+  PacketRays p = packet_rays8(o, d, &p.tmax); /* shadow_o.w: the ray's length */
+  p.tmin = (float8)(0.0f);
   const int live = (1 << n) - 1;
   const int occluded = packet_any_hit(scene, &p, live);
   for (int i = 0; i < n; ++i)
