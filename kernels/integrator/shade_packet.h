@@ -64,13 +64,15 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
   /* The bounce's numbers (bounce_random), by their use: light pick, light point, direction,
    * roulette. */
   float8 u[6];
+  uint bo[WP_SHADE_LANES];
+  for (int i = 0; i < WP_SHADE_LANES; ++i) bo[i] = path_bounce(paths, sl[i]);
+  const uint8 bounce = vload8(0, bo);
 #if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
   {
-    uint px[WP_SHADE_LANES], sa[WP_SHADE_LANES], bo[WP_SHADE_LANES];
+    uint px[WP_SHADE_LANES], sa[WP_SHADE_LANES];
     for (int i = 0; i < WP_SHADE_LANES; ++i)
-      px[i] = path_pixel(launch, sl[i]), sa[i] = path_sample(launch, sl[i]),
-      bo[i] = path_bounce(paths, sl[i]);
-    const RngLanes r = {vload8(0, px), vload8(0, sa), vload8(0, bo), launch.seed};
+      px[i] = path_pixel(launch, sl[i]), sa[i] = path_sample(launch, sl[i]);
+    const RngLanes r = {vload8(0, px), vload8(0, sa), bounce, launch.seed};
     rng_bounce_lanes(r, u);
   }
 #else
@@ -92,17 +94,18 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
   vstore8(as_uint8(tri_bits), 0, tri);
   uint4 tv[WP_SHADE_LANES];
   const Surface8 s = resolve_surface8(scene, tri, hu, hv, ray_d, tv);
-  /* Emission (shade_hit), and the paths that scatter: fewer than max_depth events so far. */
-  uint go = 0u;
-  for (int i = 0; i < n; ++i) {
-    if (!((hits >> i) & 1u)) continue;
 #if WP_FEATURE_EMISSION
+  /* Emission (shade_hit), by add_hit_emission for the lanes whose material emits (it returns at
+   * once for the others: no textures here). */
+  for (int i = 0; i < n; ++i) {
+    if (!((hits >> i) & 1u) || !(max3(scene->materials[tv[i].w].emission.xyz) > 0.0f)) continue;
     add_hit_emission(scene, paths, slots[i], WP_NO_INSTANCE, tri[i], tv[i], lane_of(t, i),
                      lane3(beta, i), lane_of(bsdf_pdf, i), lane3(ray_d, i), lane_set(s.front, i),
                      lane3(s.ng, i));
-#endif
-    if (path_bounce(paths, slots[i]) < launch.max_depth) go |= 1u << i;
   }
+#endif
+  /* The paths that scatter: fewer than max_depth events so far. */
+  const uint go = hits & (uint)lane_bits8(bounce < (uint8)(launch.max_depth));
   if (go == 0u) return n;
   const float8 cos_o = dot3x8(s.ns, neg3x8(ray_d)); /* bsdf_view */
 #if WP_STRATEGY != WP_STRATEGY_BSDF
