@@ -487,11 +487,18 @@ static inline __attribute__((always_inline)) void rng_pair_lanes(RngOrderLanes o
         rng_nested_permute8(dy, wp_hash8(seed ^ (WP_KEY_SECOND + pair * WP_PAIR_KEY_STEP)))));
 }
 
-static inline __attribute__((always_inline)) void rng_bounce_lanes(RngLanes r, float8* u) {
+/* Without `pick` or `roulette` those numbers are left out (0.5 in their place), for shading that
+ * does not read them: light picks that reuse the light point's number, no path at the roulette's
+ * depth. */
+static inline __attribute__((always_inline)) void rng_bounce_lanes(RngLanes r, float8* u, bool pick,
+                                                                   bool roulette) {
   float8 unused;
   const uint8 zero = (uint8)(0u);
-  rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_LIGHT_PICK)), zero, true, &u[0], &unused);
-  rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_ROULETTE)), zero, true, &u[5], &unused);
+  u[0] = u[5] = (float8)(0.5f);
+  if (pick)
+    rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_LIGHT_PICK)), zero, true, &u[0], &unused);
+  if (roulette)
+    rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_ROULETTE)), zero, true, &u[5], &unused);
   /* rng_pair_source, lane by lane */
   uint8 light_group = (uint8)(WP_DIM_LIGHT_U), light_pair = zero;
   uint8 bsdf_group = (uint8)(WP_DIM_BSDF_U), bsdf_pair = zero;

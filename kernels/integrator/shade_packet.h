@@ -73,7 +73,10 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
     for (int i = 0; i < WP_SHADE_LANES; ++i)
       px[i] = path_pixel(launch, sl[i]), sa[i] = path_sample(launch, sl[i]);
     const RngLanes r = {vload8(0, px), vload8(0, sa), bounce, launch.seed};
-    rng_bounce_lanes(r, u);
+    /* The light pick's own number only past WP_LIGHT_PICK_REUSE_MAX lights (sample_light),
+     * roulette's only at its depth (roulette). */
+    rng_bounce_lanes(r, u, scene->desc->light_count > WP_LIGHT_PICK_REUSE_MAX,
+                     any8(bounce + 1u >= (uint8)(launch.rr_depth)));
   }
 #else
   {
