@@ -58,4 +58,18 @@ static inline void camera_ray(const Camera* cam, float2 ndc, float2 lens_u, floa
   *tmin = znear / dot(*d, fwd);
 }
 
+#if WP_SHADE_PACKET
+/* camera_ray of eight lanes (common.h) for a pinhole camera (no lens, not orthographic): the
+ * directions and their tmin; the origin is the eye. */
+WP_LANES_FN Float3x8 camera_ray8(const Camera* cam, float8 ndc_x, float8 ndc_y, float8* tmin) {
+  const float3 fwd = cam->forward.xyz, right = cam->right.xyz, up = cam->up.xyz;
+  const Float3x8 plane = {ndc_x * right.x + ndc_y * up.x, ndc_x * right.y + ndc_y * up.y,
+                          ndc_x * right.z + ndc_y * up.z};
+  const Float3x8 f = {(float8)(fwd.x), (float8)(fwd.y), (float8)(fwd.z)};
+  const Float3x8 d = normalize3x8((Float3x8){f.x + plane.x, f.y + plane.y, f.z + plane.z});
+  *tmin = cam->position.w / dot3x8(d, f);
+  return d;
+}
+#endif
+
 #endif /* WP_CAMERA_H */

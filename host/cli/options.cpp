@@ -325,9 +325,9 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
                 "eight to a work-item in scenes without instances or alpha; the same image either "
                 "way)");
   app->add_flag("--no-shade-packets", cli.no_shade_packets,
-                "Shade each path on its own (by default PoCL's CPU devices shade eight paths to a "
-                "work-item in SIMD lanes where every surface is untextured Lambertian, without "
-                "instances or AOVs; the same image either way)");
+                "Shade each path, and start its camera ray, on its own (by default PoCL's CPU "
+                "devices take eight paths to a work-item in SIMD lanes where every surface is "
+                "untextured Lambertian, without instances or AOVs; the same image either way)");
   app->add_option("--scene-buffer-kib", cli.scene_buffer_kib,
                   "Most KiB per scene buffer; the scene is split over up to 8 [default: the "
                   "device's largest allocation, see `wavepath devices`]");

@@ -281,7 +281,8 @@ cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch&
   if (stage == Stage::kTraceShadow) last_shadow_rays_ = items;  // its queue's exact length
   if (stage == Stage::kTraceShadow && shadow_packet_ > 1 && params.shadow_packet > 1)
     items = (items + shadow_packet_ - 1) / shadow_packet_;
-  if (stage == Stage::kShade) items = (items + shade_packet_ - 1) / shade_packet_;
+  if (stage == Stage::kShade || stage == Stage::kGenerateCameraRays)  // eight paths a work-item
+    items = (items + shade_packet_ - 1) / shade_packet_;
   if (stage == Stage::kIntersectClosest && closest_packet_ > 1 && params.packet > 1)
     items = (items + closest_packet_ - 1) / closest_packet_;
   const std::size_t local = local_size_;

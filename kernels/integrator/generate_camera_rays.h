@@ -40,4 +40,44 @@ WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, ui
 #endif
 }
 
+#if WP_SHADE_PACKET
+/* Starts the paths in slots [first, first + 8) of the wave as start_path does each (a program
+ * that shades in packets: integrator/shade_packet.h), a pinhole camera's rays and the Sobol'
+ * samplers' pixel jitter in the lanes (rng_pair_lanes); path by path otherwise, and for the last
+ * slots of a wave short of eight. */
+WP_STAGE_FN void start_paths8(const Camera* camera, Paths paths, Launch launch, uint first) {
+  const uint n = min(8u, launch.path_count - first);
+  if (WP_SAMPLER == WP_SAMPLER_INDEPENDENT || n < 8u || camera_has_lens(camera) ||
+      camera->meta.x == WP_CAMERA_ORTHOGRAPHIC) {
+    for (uint i = 0u; i < n; ++i) start_path(camera, paths, launch, first + i);
+    return;
+  }
+#if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
+  uint pixel[8], sample[8], px[8], py[8];
+  for (int i = 0; i < 8; ++i) {
+    pixel[i] = path_pixel(launch, first + (uint)i),
+    sample[i] = path_sample(launch, first + (uint)i);
+    px[i] = pixel[i] % launch.width, py[i] = pixel[i] / launch.width;
+  }
+  const RngLanes r = {vload8(0, pixel), vload8(0, sample), (uint8)(0u), launch.seed};
+  float8 jx, jy; /* rng_get2's pixel jitter */
+  rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_PIXEL_X)), (uint8)(0u), false, &jx, &jy);
+  const float8 ndc_x = 2.0f * (convert_float8(vload8(0, px)) + jx) / (float)launch.width - 1.0f;
+  const float8 ndc_y = 1.0f - 2.0f * (convert_float8(vload8(0, py)) + jy) / (float)launch.height;
+  float8 tmin;
+  const Float3x8 d = camera_ray8(camera, ndc_x, ndc_y, &tmin);
+  const float3 o = camera->position.xyz;
+  for (int i = 0; i < 8; ++i) {
+    const uint slot = first + (uint)i;
+    path_store_ray_o(paths, slot, o, lane_of(tmin, i));
+    path_store_ray_d(paths, slot, lane3(d, i), 0.0f);
+    path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
+    path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
+    path_set_flags(paths, slot, 0u);
+    path_set_bounce(paths, slot, 0u);
+  }
+#endif
+}
+#endif
+
 #endif /* WP_INTEGRATOR_GENERATE_CAMERA_RAYS_H */
