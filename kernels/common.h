@@ -16,10 +16,13 @@
  * one instruction takes each lane's sign bit: LLVM 15 turns the portable version into a
  * mask-and-or reduction of seven, and a node takes four such masks. The same bits either way
  * (a comparison's lanes are all ones or all zeros); measured in docs/performance.md, "Lane masks
- * in one instruction". */
+ * in one instruction". any4: whether some lane of a four-lane mask is set, the same way. */
 #if WP_PREFETCH && defined(__AVX__)
 static inline int lane_bits8(int8 m) {
   return __builtin_ia32_movmskps256(as_float8(m));
+}
+static inline bool any4(int4 m) {
+  return __builtin_ia32_movmskps(as_float4(m)) != 0;
 }
 #else
 static inline int lane_bits8(int8 m) {
@@ -27,6 +30,9 @@ static inline int lane_bits8(int8 m) {
   const int4 b4 = b.lo | b.hi;
   const int2 b2 = b4.lo | b4.hi;
   return b2.x | b2.y;
+}
+static inline bool any4(int4 m) {
+  return any(m);
 }
 #endif
 
@@ -39,15 +45,6 @@ static inline bool any8(int8 m) {
 static inline bool all8(int8 m) {
   return lane_bits8(m) == 0xff;
 }
-#if WP_PREFETCH && defined(__AVX__)
-static inline bool any4(int4 m) {
-  return __builtin_ia32_movmskps(as_float4(m)) != 0;
-}
-#else
-static inline bool any4(int4 m) {
-  return any(m);
-}
-#endif
 
 #define WP_PI 3.14159265358979323846f
 #define WP_INV_PI 0.31830988618379067154f

@@ -8,6 +8,31 @@
 #include "camera.h"
 #include "ray_cone.h"
 
+/* A fresh path in `slot` on the camera ray (o, d) that starts at tmin. */
+WP_STAGE_FN void begin_path(const Camera* camera, Paths paths, Launch launch, uint slot, float3 o,
+                            float3 d, float tmin) {
+  path_store_ray_o(paths, slot, o, tmin);
+  path_store_ray_d(paths, slot, d, 0.0f);
+  /* A camera ray: no BSDF sample to weigh against (pdf 0). */
+  path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
+  path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
+#if WP_FEATURE_TEXTURE_LOD
+  /* Flags and bounce 0, and the camera's ray cone (ray_cone.h). */
+  const float2 cone = camera_cone(camera, launch.height);
+  path_set_bounce_word(paths, slot, with_high_bf16(0u, cone.x));
+  path_set_flags_word(paths, slot, with_high_bf16(0u, cone.y));
+#else
+  (void)camera;
+  (void)launch;
+  path_set_flags(paths, slot, 0u);
+  path_set_bounce(paths, slot, 0u);
+#endif
+#if WP_AOV
+  path_store_aov_albedo(paths, slot, (float3)(0.0f), 0.0f);
+  path_store_aov_normal(paths, slot, (float3)(0.0f), 0.0f);
+#endif
+}
+
 /* Starts the path in `slot` of the wave (slot < launch.path_count). */
 WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, uint slot) {
   const uint pixel = path_pixel(launch, slot);
@@ -20,24 +45,7 @@ WP_STAGE_FN void start_path(const Camera* camera, Paths paths, Launch launch, ui
   float3 o, d;
   float tmin;
   camera_ray(camera, ndc, lens, &o, &d, &tmin);
-  path_store_ray_o(paths, slot, o, tmin);
-  path_store_ray_d(paths, slot, d, 0.0f);
-  /* A camera ray: no BSDF sample to weigh against (pdf 0). */
-  path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
-  path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
-#if WP_FEATURE_TEXTURE_LOD
-  /* Flags and bounce 0, and the camera's ray cone (ray_cone.h). */
-  const float2 cone = camera_cone(camera, launch.height);
-  path_set_bounce_word(paths, slot, with_high_bf16(0u, cone.x));
-  path_set_flags_word(paths, slot, with_high_bf16(0u, cone.y));
-#else
-  path_set_flags(paths, slot, 0u);
-  path_set_bounce(paths, slot, 0u);
-#endif
-#if WP_AOV
-  path_store_aov_albedo(paths, slot, (float3)(0.0f), 0.0f);
-  path_store_aov_normal(paths, slot, (float3)(0.0f), 0.0f);
-#endif
+  begin_path(camera, paths, launch, slot, o, d, tmin);
 }
 
 #if WP_SHADE_PACKET
@@ -66,16 +74,9 @@ WP_STAGE_FN void start_paths8(const Camera* camera, Paths paths, Launch launch, 
   const float8 ndc_y = 1.0f - 2.0f * (convert_float8(vload8(0, py)) + jy) / (float)launch.height;
   float8 tmin;
   const Float3x8 d = camera_ray8(camera, ndc_x, ndc_y, &tmin);
-  const float3 o = camera->position.xyz;
-  for (int i = 0; i < 8; ++i) {
-    const uint slot = first + (uint)i;
-    path_store_ray_o(paths, slot, o, lane_of(tmin, i));
-    path_store_ray_d(paths, slot, lane3(d, i), 0.0f);
-    path_store_throughput(paths, slot, (float3)(1.0f), 0.0f);
-    path_store_radiance(paths, slot, (float3)(0.0f), 1.0f);
-    path_set_flags(paths, slot, 0u);
-    path_set_bounce(paths, slot, 0u);
-  }
+  for (int i = 0; i < 8; ++i)
+    begin_path(camera, paths, launch, first + (uint)i, camera->position.xyz, lane3(d, i),
+               lane_of(tmin, i));
 #endif
 }
 #endif
