@@ -327,10 +327,11 @@ TEST_F(FilmFile, ImplausibleSumsAreErrors) {
   EXPECT_NE(error_of([&] { Film::read(path("b.wpfilm")); }).find("pixel 2"), std::string::npos);
 }
 
-// The accumulate kernel against the host reference: radiance values across the fixed-point range
-// (saturation, rounding, negatives, carries into the high word over several passes) written into
-// the path state, accumulated, read back.
-TEST(FilmKernel, AccumulateMatchesTheHostReference) {
+// The accumulate kernel on a wave of width x height paths, one per pixel: radiance(pass, pixel)
+// written into the path state before each of `passes` passes, the film read back.
+Film accumulate_on_device(
+    int width, int height, std::uint32_t passes,
+    const std::function<wp::dev::float4(std::uint32_t, std::uint32_t)>& radiance) {
   wp::ClRuntime runtime(wp::select_device(""));
   wp::Scene scene;
   scene.materials.push_back(wp::test::diffuse_material({0.5f, 0.5f, 0.5f}));
@@ -338,45 +339,104 @@ TEST(FilmKernel, AccumulateMatchesTheHostReference) {
   wp::test::finish_bounds(scene);
   scene.cameras.push_back(wp::test::look_at({0, 0, 3}, {0, 0, 0}, 0.8f));
   wp::RenderSettings settings;
-  settings.width = 4;
-  settings.height = 2;
+  settings.width = width;
+  settings.height = height;
   std::vector<std::uint32_t> flags;
   wp::bvh::BuildOptions options;
   options.width = wp::bvh_width(runtime.device(), settings);
   const wp::bvh::Bvh bvh = wp::bvh::build(wp::bvh_input(scene, flags), options);
   wp::Wavefront wf(runtime, scene, bvh, settings);
-
-  const std::vector<float> values = {
-      0.0f,    1.0f,          0.5f,          0x1p-33f, 0x3p-33f, 1e-10f, 123.456f, 65535.99f,
-      0x1p31f, 4294967040.0f, 4294967296.0f, 1e20f,    -1.0f,    -0.0f,  3.0e9f,   7.25f};
-  constexpr std::uint32_t kPixels = 8;
+  const auto pixels = static_cast<std::uint32_t>(width * height);
   const auto& layout = wf.path_state().layout;
-  std::vector<Uint128> sums(kPixels * 3, 0), squares(kPixels * 3, 0);
-  for (std::uint32_t pass = 0; pass < 6; ++pass) {
-    std::vector<wp::dev::float4> radiance(kPixels);
-    for (std::uint32_t i = 0; i < kPixels; ++i) {
-      float v[3];
-      for (std::uint32_t c = 0; c < 3; ++c) {
-        v[c] = values[(5 * pass + 3 * i + c) % values.size()];
-        if (pass % 2 == 1 && i == 2) v[c] = 4294967296.0f;  // saturated: carries every time
-        const std::uint64_t a = wp::film_fixed(v[c]);
-        sums[3 * i + c] += a;  // path slot i renders pixel i (a wave of the whole image)
-        squares[3 * i + c] += wp::film_square(a);
-      }
-      radiance[i] = {v[0], v[1], v[2], 0.0f};
-    }
-    wf.write_paths(layout.radiance, radiance);
-    wf.launch_stage(wp::Stage::kAccumulate, kPixels, wf.launch_params(pass, 0, kPixels));
+  for (std::uint32_t pass = 0; pass < passes; ++pass) {
+    std::vector<wp::dev::float4> values(pixels);
+    for (std::uint32_t i = 0; i < pixels; ++i) values[i] = radiance(pass, i);
+    wf.write_paths(layout.radiance, values);
+    wf.launch_stage(wp::Stage::kAccumulate, pixels, wf.launch_params(pass, 0, pixels));
   }
   wf.finish();
-  const Film film = wf.film(film_info(4, 2, 0, 6));
-  for (std::size_t p = 0; p < kPixels; ++p)
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_TRUE(film.sum(p, c) == sums[3 * p + c]) << "pixel " << p << " channel " << c;
-      EXPECT_TRUE(film.squares(p, c) == squares[3 * p + c]) << "pixel " << p << " channel " << c;
-    }
-  EXPECT_GE(film.sum(2, 0), Uint128(kMax) * 3);  // carried into the high word
   EXPECT_EQ(wf.nonfinite_samples(), 0u);
+  return wf.film(film_info(width, height, 0, passes));
+}
+
+// The film of accumulate_on_device as the host computes it (film_fixed, film_square).
+void expect_host_film(
+    const Film& film, std::uint32_t passes,
+    const std::function<wp::dev::float4(std::uint32_t, std::uint32_t)>& radiance) {
+  for (std::size_t p = 0; p < film.pixels(); ++p) {
+    Uint128 sums[3] = {0, 0, 0}, squares[3] = {0, 0, 0};
+    for (std::uint32_t pass = 0; pass < passes; ++pass) {
+      const wp::dev::float4 v = radiance(pass, static_cast<std::uint32_t>(p));
+      const float c3[3] = {v.x, v.y, v.z};
+      for (int c = 0; c < 3; ++c) {
+        const std::uint64_t a = wp::film_fixed(c3[c]);
+        sums[c] += a;
+        squares[c] += wp::film_square(a);
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(film.sum(p, c) == sums[c]) << "pixel " << p << " channel " << c;
+      EXPECT_TRUE(film.squares(p, c) == squares[c]) << "pixel " << p << " channel " << c;
+    }
+  }
+}
+
+// The accumulate kernel against the host reference: radiance values across the fixed-point range
+// (saturation, rounding, negatives, carries into the high word over several passes) written into
+// the path state, accumulated, read back.
+TEST(FilmKernel, AccumulateMatchesTheHostReference) {
+  // Units of 2^-32 (the film's): ties 0.5, 1.5, 2.5 and 2^23 - 0.5, 2^23 - 1.5 (the kernel rounds
+  // below 2^23 units by adding 2^23), 2^23 and 2^23 + 1, the largest value below 2^32 and 2^32
+  // (saturates).
+  const std::vector<float> values = {
+      0.0f,           1.0f,     0.5f,          0x1p-33f,        0x3p-33f,        0x5p-33f,
+      1e-10f,         123.456f, 65535.99f,     0x1.fffffep-10f, 0x1.fffffap-10f, 0x1p-9f,
+      0x1.000002p-9f, 0x1p31f,  4294967040.0f, 4294967296.0f,   1e20f,           -1.0f,
+      -0.0f,          3.0e9f,   7.25f,         0x1.fffffcp-10f};
+  const auto radiance = [&](std::uint32_t pass, std::uint32_t i) {
+    float v[3];
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      v[c] = values[(5 * pass + 3 * i + c) % values.size()];
+      if (pass % 2 == 1 && i == 2) v[c] = 4294967296.0f;  // saturated: carries every time
+    }
+    return wp::dev::float4{v[0], v[1], v[2], 0.0f};
+  };
+  const Film film = accumulate_on_device(4, 2, 6, radiance);
+  expect_host_film(film, 6, radiance);
+  EXPECT_GE(film.sum(2, 0), Uint128(kMax) * 3);  // carried into the high word
+}
+
+// The same, densely: floats in [2^-40, 2^34) (the film's units [2^-8, 2^66), saturation included)
+// from random bit patterns, 2^16 pixels by 3 channels by 2 passes; and the 128 floats below 2^23
+// units and the 128 from it (the kernel's two ways of rounding meet there; ties below).
+TEST(FilmKernel, AccumulateMatchesTheHostReferenceDensely) {
+  constexpr int kSide = 256;
+  const auto bits_of = [](std::uint32_t pass, std::uint32_t i, std::uint32_t c) {
+    std::uint64_t z = (std::uint64_t(pass) << 40) ^ (std::uint64_t(i) << 2) ^ c;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;  // a splitmix64 finaliser: well-mixed bits
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return static_cast<std::uint32_t>(z ^ (z >> 31));
+  };
+  const auto radiance = [&](std::uint32_t pass, std::uint32_t i) {
+    float v[3];
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      const std::uint32_t k = 3 * i + c;
+      if (pass == 0 && k < 256) {  // 2^23 units = 2^-9: 128 floats below it, 128 from it
+        std::uint32_t b;
+        const float mid = 0x1p-9f;
+        std::memcpy(&b, &mid, 4);
+        b = b - 128u + k;
+        std::memcpy(&v[c], &b, 4);
+      } else {  // exponents -40 to 33: biased 87 to 160, any mantissa
+        const std::uint32_t r = bits_of(pass, i, c);
+        const std::uint32_t b = ((87u + (r >> 23) % 74u) << 23) | (r & 0x7fffffu);
+        std::memcpy(&v[c], &b, 4);
+      }
+    }
+    return wp::dev::float4{v[0], v[1], v[2], 0.0f};
+  };
+  const Film film = accumulate_on_device(kSide, kSide, 2, radiance);
+  expect_host_film(film, 2, radiance);
 }
 
 // The command line, as users run it: the Cornell box at 24 x 16, rendered once with 6 samples and

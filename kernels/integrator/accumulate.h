@@ -24,9 +24,23 @@ static inline void film_add128(__global ulong* v, ulong lo, ulong hi) {
   v[0] = sum;
 }
 
+/* round(v * 2^32), ties to even, saturated to [0, 2^64 - 1], for a finite v: what
+ * convert_ulong_sat_rte(v * 2^32) gives, in a few instructions where PoCL expands that built-in
+ * (and rint) into chains of range tests and branches. v * 2^32 is exact (a power of two). Below
+ * 2^23, adding 2^23 leaves no fraction bits, so the sum is rounded to an integer by the float
+ * addition itself (to nearest, ties to even: OpenCL's rounding mode) and subtracting 2^23 again
+ * is exact; from 2^23 on a float is an integer already, and one below 2^64 converts to ulong
+ * exactly. Checked against the host's film_fixed (nearbyint) on the rounding ties and the
+ * saturation bounds by FilmKernel.AccumulateMatchesTheHostReference. */
+static inline ulong film_fixed(float v) {
+  const float x = fmax(v * 0x1p32f, 0.0f);
+  const float r = x < 0x1p23f ? (x + 0x1p23f) - 0x1p23f : x;
+  return r < 0x1p64f ? convert_ulong(r) : ULONG_MAX;
+}
+
 /* Adds one channel's value v to the sums at `px` (the pixel's first word). */
 static inline void film_add_value(__global ulong* px, uint channel, float v) {
-  const ulong a = convert_ulong_sat_rte(v * 0x1p32f);
+  const ulong a = film_fixed(v);
   const ulong sq_lo = a * a, sq_hi = mul_hi(a, a); /* a^2, 128 bits */
   film_add128(px + WP_FILM_SUM(channel), a, 0ul);
   film_add128(px + WP_FILM_SQUARES(channel), (sq_hi << 32) | (sq_lo >> 32), sq_hi >> 32);
@@ -40,10 +54,10 @@ static inline void film_add_value(__global ulong* px, uint channel, float v) {
 static inline void film_add_aovs(__global ulong* px, float3 albedo, float3 normal, float depth) {
   const float a[3] = {albedo.x, albedo.y, albedo.z}, n[3] = {normal.x, normal.y, normal.z};
   for (uint c = 0; c < 3u; ++c) {
-    film_add128(px + WP_FILM_ALBEDO(c), convert_ulong_sat_rte(a[c] * 0x1p32f), 0ul);
-    film_add128(px + WP_FILM_NORMAL(c), convert_ulong_sat_rte((n[c] + 1.0f) * 0x1p32f), 0ul);
+    film_add128(px + WP_FILM_ALBEDO(c), film_fixed(a[c]), 0ul);
+    film_add128(px + WP_FILM_NORMAL(c), film_fixed(n[c] + 1.0f), 0ul);
   }
-  film_add128(px + WP_FILM_DEPTH, convert_ulong_sat_rte(depth * 0x1p32f), 0ul);
+  film_add128(px + WP_FILM_DEPTH, film_fixed(depth), 0ul);
 }
 #endif
 
