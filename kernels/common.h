@@ -97,8 +97,16 @@ static inline float3 offset_origin(float3 p, float3 n, float scale) {
   return p + n * offset_distance(scale);
 }
 
-/* Always inlined: a float8 triple passed to a function kept out of line goes through memory. */
+/* Always inlined: a float8 triple passed to a function kept out of line goes through memory. Not
+ * where the host forces the packet kernels onto a device other than PoCL's CPU devices
+ * (WP_PACKETS_FORCED, --force-packets: the Oclgrind tests), where speed does not matter:
+ * Oclgrind cannot run what an always-inlined function returning a struct leaves behind
+ * (stage.h). */
+#if WP_PACKETS_FORCED
+#define WP_LANES_FN static inline
+#else
 #define WP_LANES_FN static inline __attribute__((always_inline))
+#endif
 
 /* Eight float4 as four float8 of their components, lane i from v[i] (shade, ray packets). */
 WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, float8* w) {

@@ -21,6 +21,11 @@
 #ifndef WP_SHADE_PACKET
 #define WP_SHADE_PACKET 0
 #endif
+/* 1 where the host builds those packet kernels for a device other than PoCL's CPU devices
+ * (--force-packets, for the Oclgrind tests; common.h, WP_LANES_FN). */
+#ifndef WP_PACKETS_FORCED
+#define WP_PACKETS_FORCED 0
+#endif
 #ifndef WP_FEATURE_PUNCTUAL_LIGHTS
 #define WP_FEATURE_PUNCTUAL_LIGHTS 1 /* point, spot or directional lights */
 #endif

@@ -436,14 +436,13 @@ typedef struct RngLanes {
 } RngLanes;
 
 /* rng_group_seed of group `group` in every lane. */
-static inline __attribute__((always_inline)) uint8 rng_group_seed_lanes(RngLanes r, uint8 group) {
+WP_LANES_FN uint8 rng_group_seed_lanes(RngLanes r, uint8 group) {
   return wp_hash8(wp_hash8(r.bounce * WP_DIMS_PER_BOUNCE + group + wp_hash(r.seed)) ^ r.pixel);
 }
 
 /* rng_sobol_pair_digits of eight indices, the same pair p in every lane: the generator matrices'
  * columns (the entries of one-bit nibbles) xored in where the index has their bit, in the lanes. */
-static inline __attribute__((always_inline)) void rng_sobol_pair_digits8(uint8 index, uint p,
-                                                                         uint8* x, uint8* y) {
+WP_LANES_FN void rng_sobol_pair_digits8(uint8 index, uint p, uint8* x, uint8* y) {
   __constant const uint(*t)[32] = wp_sobol_pairs[p - 1u];
   uint8 dx = (uint8)(0u), dy = (uint8)(0u);
 #pragma unroll
@@ -460,8 +459,7 @@ typedef struct RngOrderLanes {
   uint8 seed, index;
 } RngOrderLanes;
 
-static inline __attribute__((always_inline)) RngOrderLanes rng_order_lanes(RngLanes r,
-                                                                           uint8 group) {
+WP_LANES_FN RngOrderLanes rng_order_lanes(RngLanes r, uint8 group) {
   const uint8 seed = rng_group_seed_lanes(r, group);
   const RngOrderLanes o = {seed, rng_owen8(r.sample, seed)};
   return o;
@@ -469,8 +467,7 @@ static inline __attribute__((always_inline)) RngOrderLanes rng_order_lanes(RngLa
 
 /* A pair of numbers (rng_get2's) of the order o, its pair `pair` in each lane; with one_d only
  * the first (rng_get's for a one-dimensional group of pair 0). */
-static inline __attribute__((always_inline)) void rng_pair_lanes(RngOrderLanes o, uint8 pair,
-                                                                 bool one_d, float8* u, float8* v) {
+WP_LANES_FN void rng_pair_lanes(RngOrderLanes o, uint8 pair, bool one_d, float8* u, float8* v) {
   const uint8 seed = o.seed, index = o.index;
   uint8 dx = index, dy = rng_taylor_shift8(index);
   for (uint q = 1u; q <= 3u; ++q) {
@@ -490,8 +487,7 @@ static inline __attribute__((always_inline)) void rng_pair_lanes(RngOrderLanes o
 /* Without `pick` or `roulette` those numbers are left out (0.5 in their place), for shading that
  * does not read them: light picks that reuse the light point's number, no path at the roulette's
  * depth. */
-static inline __attribute__((always_inline)) void rng_bounce_lanes(RngLanes r, float8* u, bool pick,
-                                                                   bool roulette) {
+WP_LANES_FN void rng_bounce_lanes(RngLanes r, float8* u, bool pick, bool roulette) {
   float8 unused;
   const uint8 zero = (uint8)(0u);
   u[0] = u[5] = (float8)(0.5f);

@@ -328,6 +328,11 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
                 "Shade each path, and start its camera ray, on its own (by default PoCL's CPU "
                 "devices take eight paths to a work-item in SIMD lanes where every surface is "
                 "untextured Lambertian, without instances or AOVs; the same image either way)");
+  app->add_flag("--force-packets", cli.force_packets,
+                "Use the eight-lane packet kernels (rays, shading and camera rays in SIMD lanes) "
+                "on any device, where by default only PoCL's CPU devices use them: for testing "
+                "them elsewhere, e.g. under Oclgrind (tests/test_oclgrind.sh); slower on GPUs. "
+                "The same image");
   app->add_option("--scene-buffer-kib", cli.scene_buffer_kib,
                   "Most KiB per scene buffer; the scene is split over up to 8 [default: the "
                   "device's largest allocation, see `wavepath devices`]");
@@ -459,6 +464,7 @@ void prepare_render(const CLI::App& render, CliOptions& cli, wp::RenderSettings&
   settings.shadow_packets = !cli.no_shadow_packets;
   settings.closest_packets = !cli.no_closest_packets;
   settings.shade_packets = !cli.no_shade_packets;
+  settings.force_packets = cli.force_packets;
   if (!cli.no_kernel_cache) settings.kernel_cache_dir = wp::cache_dir();
   if (cli.no_rr) settings.rr_depth = std::numeric_limits<int>::max();
   wp::validate(settings);

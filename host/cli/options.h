@@ -41,6 +41,7 @@ struct CliOptions {
   bool no_shadow_packets = false;
   bool no_closest_packets = false;
   bool no_shade_packets = false;
+  bool force_packets = false;
   bool no_kernel_cache = false;
   std::string features = "scene";
   std::string tonemap = "aces";

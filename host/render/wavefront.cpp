@@ -132,8 +132,10 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   // Rays eight to a work-item (kernels/traverse8_packet.h) on the wide layout without instances
   // or alpha: shadow rays where they are plain any-hit queries (no transmission), closest-hit
   // rays always there. Only on PoCL's CPU devices, where it was measured (docs/performance.md,
-  // "Shadow rays in packets of eight", "Closest-hit rays in packets"). The same image either way.
-  const bool packets = pocl_cpu && bvh.width == 8 && !features_.instances && !features_.alpha;
+  // "Shadow rays in packets of eight", "Closest-hit rays in packets"), unless the settings force
+  // them (the Oclgrind tests). The same image either way.
+  const bool packets_here = pocl_cpu || settings.force_packets;
+  const bool packets = packets_here && bvh.width == 8 && !features_.instances && !features_.alpha;
   shadow_packet_ = settings.shadow_packets && packets && !features_.transmission ? 8u : 1u;
   closest_packet_ = settings.closest_packets && packets ? 8u : 1u;
   if (shadow_packet_ > 1) options_ += " -D WP_SHADOW_PACKET=1";
@@ -146,8 +148,10 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
                           !f.volume && !f.specular && !f.clearcoat && !f.sheen && !f.anisotropy &&
                           !f.iridescence && !f.diffuse_transmission && !f.dispersion &&
                           !f.instances;
-  shade_packet_ = settings.shade_packets && pocl_cpu && lambertian && !settings.aov ? 8u : 1u;
+  shade_packet_ = settings.shade_packets && packets_here && lambertian && !settings.aov ? 8u : 1u;
   if (shade_packet_ > 1) options_ += " -D WP_SHADE_PACKET=1";
+  const bool forced = !pocl_cpu && (shade_packet_ > 1 || shadow_packet_ > 1 || closest_packet_ > 1);
+  if (forced) options_ += " -D WP_PACKETS_FORCED=1";
   memory_ = state_memory(settings, features_);
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);

@@ -95,6 +95,9 @@ struct RenderSettings {
   // PoCL's CPU devices, in scenes of untextured Lambertian surfaces without instances or AOVs.
   // The same image.
   bool shade_packets = true;
+  // The packet kernels above on any device, not only on PoCL's CPU devices (tests run them under
+  // Oclgrind with it). The same image.
+  bool force_packets = false;
   int bvh_width = 0;  // BVH layout: 2, 8, or 0 for the device's default (render.h)
   // Where built kernel programs are cached (host/device/program_cache.h; the command line passes
   // bvh::cache_dir()); empty: nothing is cached.

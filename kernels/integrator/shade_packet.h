@@ -120,6 +120,12 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
     float8 pmf, rest;
     vstore8(pick_light8(scene, reuse ? light_u : light_pick, &pmf, &rest), 0, picked);
     const float8 lu = reuse ? rest : light_u;
+    /* The constant background, sampled in the lanes (no map to look up). */
+#if WP_FEATURE_ENVIRONMENT
+    const bool uniform_env = scene->desc->env_width == 0u;
+#else
+    const bool uniform_env = true;
+#endif
     for (int i = 0; i < WP_SHADE_LANES; ++i) {
       const uint4 meta = scene->lights[picked[i]].meta;
       const bool triangle = meta.x == WP_LIGHT_TRIANGLE;
@@ -127,8 +133,7 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
       if (!((go >> i) & 1u)) continue;
       if (triangle) {
         lanes |= 1u << i;
-      } else if (meta.x == WP_LIGHT_ENVIRONMENT &&
-                 !(WP_FEATURE_ENVIRONMENT && scene->desc->env_width > 0u)) {
+      } else if (meta.x == WP_LIGHT_ENVIRONMENT && uniform_env) {
         lanes |= 1u << i, env |= 1u << i;
       } else {
         const Surface one = surface_lane(scene, &s, tv[i], i);
