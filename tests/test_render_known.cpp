@@ -679,6 +679,32 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
     EXPECT_GT(sum, 0.0);
     EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ";
   }
+  // Rows not a multiple of eight pixels, so that camera-ray packets span two rows (start_paths8
+  // counts pixels on from the first one's), and waves of two samples of the image (a packet across
+  // the samples' boundary), of 1000 and of 8 paths: 61 x 37, with a wall behind everything, a
+  // light before it and a black background, so that every pixel, and those just past the image's
+  // edges, sees a surface whose light depends on where it is (a ray into another pixel changes
+  // the film; under a constant sky a plane's points all look alike for the same numbers).
+  wp::Scene walled = s;
+  wp::test::add_quad(walled, {-50, -50, -3}, {50, -50, -3}, {50, 50, -3}, {-50, 50, -3}, 0);
+  wp::PunctualLight front;
+  front.position = {0.0f, 1.5f, 4.0f};
+  front.intensity = {3.0f, 3.0f, 3.0f};
+  walled.lights.push_back(front);
+  wp::test::finish_bounds(walled);
+  for (const std::size_t wave : {std::size_t(2 * 61 * 37), std::size_t(1000), std::size_t(8)}) {
+    SCOPED_TRACE("61 x 37, wave " + std::to_string(wave));
+    wp::RenderSettings st = settings_for(walled, vec3(0.0f));
+    st.sampler = wp::Sampler::kSobol;  // camera packets draw the Sobol' jitter in the lanes
+    st.width = 61;
+    st.height = 37;
+    st.spp = 2;
+    st.wave_size = wave;
+    const wp::Rendered packets = wp::render(*runtime_, walled, st);
+    st.shade_packets = false;
+    const wp::Rendered single = wp::render(*runtime_, walled, st);
+    EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ";
+  }
   // Past WP_LIGHT_PICK_REUSE_MAX (64) lights the pick takes a number of its own (lights.h), which
   // the lanes otherwise leave out: 40 more lamp quads, 80 triangles.
   for (int i = 0; i < 40; ++i) {
