@@ -2,11 +2,12 @@
  * (host/film/film.h) and the .wpfilm file, which stores the device buffer word for word.
  *
  * A sample's radiance v (per channel; finite, NaN/Inf are dropped and counted before) becomes the
- * integer a = round(v * 2^32), saturated to [0, 2^64 - 1] (convert_ulong_sat_rte): 32 fraction
- * bits, so values below 2^-33 round to 0 and values from 2^32 on saturate. Per pixel and channel
- * the film keeps two 128-bit unsigned sums, S = sum(a) and Q = sum(floor(a^2 / 2^32)), so
- * mean = S / 2^32 / n and sum(v^2) = Q / 2^32. Integer addition is associative and commutative:
- * films of disjoint sample ranges add up, in any order, to exactly the film of one render.
+ * integer a = round(v * 2^32), ties to even, saturated to [0, 2^64 - 1] (integrator/accumulate.h,
+ * film_fixed): 32 fraction bits, so values below 2^-33 round to 0 and values from 2^32 on
+ * saturate. Per pixel and channel the film keeps two 128-bit unsigned sums, S = sum(a) and
+ * Q = sum(floor(a^2 / 2^32)), so mean = S / 2^32 / n and sum(v^2) = Q / 2^32. Integer addition
+ * is associative and commutative: films of disjoint sample ranges add up, in any order, to exactly
+ * the film of one render.
  *
  * Ranges: a < 2^64 and a^2 / 2^32 < 2^96, so after n <= WP_FILM_MAX_SAMPLES = 2^20 samples
  * S < 2^84 and Q < 2^116: no sum can overflow 128 bits, whatever the values (saturated ones
