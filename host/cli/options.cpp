@@ -330,9 +330,9 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
                 "untextured Lambertian, without instances or AOVs; the same image either way)");
   app->add_flag("--force-packets", cli.force_packets,
                 "Use the eight-lane packet kernels (rays, shading and camera rays in SIMD lanes) "
-                "on any device, where by default only PoCL's CPU devices use them: for testing "
-                "them elsewhere, e.g. under Oclgrind (tests/test_oclgrind.sh); slower on GPUs. "
-                "The same image");
+                "on any device, for testing them elsewhere, e.g. under Oclgrind "
+                "(tests/test_oclgrind.sh); by default only PoCL's CPU devices use them, where "
+                "they were measured. The same image");
   app->add_option("--scene-buffer-kib", cli.scene_buffer_kib,
                   "Most KiB per scene buffer; the scene is split over up to 8 [default: the "
                   "device's largest allocation, see `wavepath devices`]");

@@ -31,7 +31,8 @@ static inline void film_add128(__global ulong* v, ulong lo, ulong hi) {
  * addition itself (to nearest, ties to even: OpenCL's rounding mode) and subtracting 2^23 again
  * is exact; from 2^23 on a float is an integer already, and one below 2^64 converts to ulong
  * exactly. Checked against the host's film_fixed (nearbyint) on the rounding ties and the
- * saturation bounds by FilmKernel.AccumulateMatchesTheHostReference. */
+ * saturation bounds by FilmKernel.AccumulateMatchesTheHostReference, and over floats from 2^-40
+ * to 2^34 by its Densely twin. */
 static inline ulong film_fixed(float v) {
   const float x = fmax(v * 0x1p32f, 0.0f);
   const float r = x < 0x1p23f ? (x + 0x1p23f) - 0x1p23f : x;
