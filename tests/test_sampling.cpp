@@ -494,6 +494,88 @@ Config with_samples(Config c, std::uint32_t samples) {
 
 const float4 kWhite = {1, 1, 1, 0}, kSaturated = {0.9f, 0.1f, 0.02f, 0};
 
+// The eight-lane twins of common.h, elementary.h and sampling.h (tests/kernels/lanes_kernels.cl)
+// against their scalar originals on the same inputs, bit for bit, as the packet kernels need
+// (integrator/shade_packet.h: the same images with and without packets): vectors whose squared
+// length is zero, subnormal, just inside and outside (1e-30, 1e30) (where length3x8 and
+// normalize3x8 hand the lane to the builtin) or huge, mixed in one packet with ordinary ones, and
+// signed zeros; fractions of a turn and unit-square points at their boundaries. NaN results (the
+// zero vector's normal) must be NaN on both sides. Built with and without WP_PREFETCH (lane_bits8's
+// x86 builtin or its generic form).
+TEST(LaneTwins, MatchTheirScalarFunctions) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f), exponent(-25.0f, 25.0f);
+  std::vector<cl_float4> vectors;
+  const float edges[] = {0.0f,   -0.0f,   1e-20f, 1e-15f, 3e-16f, 1e15f,  3e15f, 1e20f,
+                         1e-40f, -2e-40f, 1.0f,   -1.0f,  0.5f,   1e-38f, 3e19f, -7e14f};
+  for (float a : edges)
+    for (float b : edges) {
+      vectors.push_back({{a, b, 0.0f, 0.0f}});
+      vectors.push_back({{b, 0.0f, a, 0.0f}});
+      vectors.push_back({{a, a, b, 0.0f}});
+    }
+  for (float base : {1e-15f, 1e15f})  // squared lengths at the plain range's ends
+    for (int k = -4; k <= 4; ++k) {
+      float x = base;
+      for (int step = 0; step < (k < 0 ? -k : k); ++step)
+        x = std::nextafter(x, k < 0 ? 0.0f : 1e30f);
+      vectors.push_back({{x, 0.0f, 0.0f, 0.0f}});
+      vectors.push_back({{0.0f, -x, 0.0f, 0.0f}});
+    }
+  for (int i = 0; i < 4096; ++i) {  // ordinary vectors, and magnitudes from 1e-25 to 1e25
+    cl_float4 v = {{unit(rng), unit(rng), unit(rng), 0.0f}};
+    if (i % 2)
+      for (int c = 0; c < 3; ++c) v.s[c] *= std::pow(10.0f, exponent(rng));
+    vectors.push_back(v);
+  }
+  std::shuffle(vectors.begin(), vectors.end(), rng);  // unusual lanes beside ordinary ones
+  for (std::size_t i = 0; i < vectors.size(); ++i) vectors[i].s[3] = unit(rng);  // offset scale
+  std::vector<cl_float4> fractions;  // (x, y) in the unit square, w a fraction of a turn
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  const float ends[] = {0.0f,
+                        0.25f,
+                        0.5f,
+                        0.75f,
+                        std::nextafter(1.0f, 0.0f),
+                        1.0f,
+                        std::nextafter(0.125f, 0.0f),
+                        0.125f,
+                        std::nextafter(0.125f, 1.0f)};
+  for (float a : ends)
+    for (float b : ends)
+      fractions.push_back({{a, std::min(b, std::nextafter(1.0f, 0.0f)), 0.0f, a}});
+  for (int i = 0; i < 4096; ++i) fractions.push_back({{u01(rng), u01(rng), 0.0f, u01(rng)}});
+  for (auto* set : {&vectors, &fractions})
+    while (set->size() % 8) set->push_back({{1.0f, 2.0f, 3.0f, 0.5f}});
+
+  const auto same = [](float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b));
+  };
+  const char* names[] = {"length",       "normalize",         "dot",
+                         "cross",        "make_basis t",      "make_basis b",
+                         "cos_sin_turn", "cosine hemisphere", "offset_origin"};
+  for (const char* options : {"-D WP_SHADE_PACKET=1", "-D WP_SHADE_PACKET=1 -D WP_PREFETCH=1"}) {
+    wp::test::KernelHarness h({"lanes_kernels.cl"}, options);
+    for (cl_uint fn = 0; fn < 9; ++fn) {
+      const std::vector<cl_float4>& in = fn == 6 || fn == 7 ? fractions : vectors;
+      const auto groups = static_cast<cl_uint>(in.size() / 8);
+      cl::Buffer b_in = h.buffer(in), lanes = h.buffer<cl_float4>(in.size()),
+                 scalar = h.buffer<cl_float4>(in.size());
+      h.run("lane_twins", groups, b_in, groups, fn, lanes, scalar);
+      const auto l = h.read<cl_float4>(lanes, in.size()), s = h.read<cl_float4>(scalar, in.size());
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < in.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+          if (!same(l[i].s[c], s[i].s[c]) && differ++ < 3)
+            ADD_FAILURE() << options << ", " << names[fn] << " of (" << in[i].s[0] << ", "
+                          << in[i].s[1] << ", " << in[i].s[2] << ", " << in[i].s[3]
+                          << "), component " << c << ": lanes " << l[i].s[c] << ", scalar "
+                          << s[i].s[c];
+      EXPECT_EQ(differ, 0u) << options << ", " << names[fn];
+    }
+  }
+}
+
 // cos_sin_turn (kernels/sampling.h), the (cos, sin) of 2 pi u that the GGX visible-normal samplers
 // and the uniform sphere use instead of the library's cos and sin: against double precision at u
 // (the float itself), on a dense grid and at every quarter turn's boundary and its neighbours. The
