@@ -28,6 +28,7 @@
 #include "host/render/render.h"
 #include "host/render/wavefront.h"
 #include "tests/cli_run.h"
+#include "tests/float_bits.h"
 #include "tests/scene_factory.h"
 #include "tests/test_assets.h"
 
@@ -422,15 +423,10 @@ TEST(FilmKernel, AccumulateMatchesTheHostReferenceDensely) {
     for (std::uint32_t c = 0; c < 3; ++c) {
       const std::uint32_t k = 3 * i + c;
       if (pass == 0 && k < 256) {  // 2^23 units = 2^-9: 128 floats below it, 128 from it
-        std::uint32_t b;
-        const float mid = 0x1p-9f;
-        std::memcpy(&b, &mid, 4);
-        b = b - 128u + k;
-        std::memcpy(&v[c], &b, 4);
+        v[c] = wp::test::as_float(wp::test::bits(0x1p-9f) - 128u + k);
       } else {  // exponents -40 to 33: biased 87 to 160, any mantissa
         const std::uint32_t r = bits_of(pass, i, c);
-        const std::uint32_t b = ((87u + (r >> 23) % 74u) << 23) | (r & 0x7fffffu);
-        std::memcpy(&v[c], &b, 4);
+        v[c] = wp::test::as_float(((87u + (r >> 23) % 74u) << 23) | (r & 0x7fffffu));
       }
     }
     return wp::dev::float4{v[0], v[1], v[2], 0.0f};

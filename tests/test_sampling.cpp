@@ -40,6 +40,7 @@
 #include "host/lights/light_table.h"
 #include "kernels/shared/types.h"
 #include "tests/chi2.h"
+#include "tests/float_bits.h"
 #include "tests/kernel_harness.h"
 #include "tests/sphere_bins.h"
 
@@ -549,7 +550,7 @@ TEST(LaneTwins, MatchTheirScalarFunctions) {
     while (set->size() % 8) set->push_back({{1.0f, 2.0f, 3.0f, 0.5f}});
 
   const auto same = [](float a, float b) {
-    return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b));
+    return wp::test::bits(a) == wp::test::bits(b) || (std::isnan(a) && std::isnan(b));
   };
   const char* names[] = {"length",       "normalize",         "dot",
                          "cross",        "make_basis t",      "make_basis b",
