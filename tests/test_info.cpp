@@ -263,7 +263,9 @@ TEST_F(InfoCli, MemoryAndCacheMatchRender) {
       run("render '" + cornell() + "' " + size + " --bvh-width 8 --spp 1 -q --json -o out.pfm");
   ASSERT_EQ(r.status, 0) << r.err;
   const json rendered = json::parse(r.out);
-  const json after = info(cornell(), size);
+  // The wave of the device the render ran on (a CPU device's fits its cache: auto_wave_paths).
+  const json after =
+      info(cornell(), size + " --device '" + rendered["device"].get<std::string>() + "'");
   const json& wide = after["bvh"][0];
   ASSERT_EQ(wide["width"], 8);
   EXPECT_EQ(wide["cache"], "valid");

@@ -437,6 +437,56 @@ TEST(PackedSize, ImageMemoryIsChecked) {
 
 // The kernels find every array wherever it lies: a textured, lit scene with an environment map,
 // split over several buffers, renders bit for bit as in one, with either BVH layout.
+// A CPU device's default wave is the largest power of two of paths whose path state and queue
+// slots fit its global memory cache, within [2^16, 2^20], swept across each power's threshold;
+// a GPU, or a device that reports no cache, keeps min(pixels, 2^20) pixels (several samples of an
+// image under kMultiSamplePaths pixels). An explicit --wave-size wins over both, and the
+// Wavefront and the memory check see the same wave (state_memory with the device).
+TEST(WaveShape, CpuWavesFitTheCache) {
+  DeviceEntry cpu;
+  cpu.gpu = false;
+  const std::size_t per_path = 128;  // 112 B of fused state and four 4-byte queue slots
+  for (std::size_t k = 16; k <= 20; ++k) {
+    const std::size_t paths = std::size_t(1) << k;
+    cpu.cache_bytes = paths * per_path;  // exactly 2^k paths fit
+    EXPECT_EQ(auto_wave_paths(&cpu, per_path), paths) << k;
+    cpu.cache_bytes = paths * per_path - 1;  // one byte short of them
+    EXPECT_EQ(auto_wave_paths(&cpu, per_path), std::max(paths / 2, std::size_t(1) << 16)) << k;
+  }
+  cpu.cache_bytes = 1;  // smaller than one path: the floor
+  EXPECT_EQ(auto_wave_paths(&cpu, per_path), std::size_t(1) << 16);
+  cpu.cache_bytes = 1ull << 40;  // the ceiling
+  EXPECT_EQ(auto_wave_paths(&cpu, per_path), std::size_t(1) << 20);
+  cpu.cache_bytes = 0;  // not reported
+  EXPECT_EQ(auto_wave_paths(&cpu, per_path), 0u);
+  DeviceEntry gpu = cpu;
+  gpu.gpu = true;
+  gpu.cache_bytes = 32ull << 20;
+  EXPECT_EQ(auto_wave_paths(&gpu, per_path), 0u);
+  EXPECT_EQ(auto_wave_paths(nullptr, per_path), 0u);
+
+  RenderSettings s;
+  s.width = 1280, s.height = 720;
+  const SceneFeatures features;   // the fused 112-byte state (PathState test below)
+  cpu.cache_bytes = 32ull << 20;  // 2^18 paths of 128 bytes
+  StateMemory m = state_memory(s, features, &cpu);
+  EXPECT_EQ(m.wave.pixels, 262144u);
+  EXPECT_EQ(m.wave.samples, 1u);
+  EXPECT_EQ(m.path_state.bytes_per_path, 112u);
+  m = state_memory(s, features, &gpu);
+  EXPECT_EQ(m.wave.pixels, 921600u);
+  EXPECT_EQ(m.wave.samples, 1u);
+  s.width = s.height = 100;  // 10^4 pixels: whole samples of them
+  m = state_memory(s, features, &cpu);
+  EXPECT_EQ(m.wave.pixels, 10000u);
+  EXPECT_EQ(m.wave.samples, 26u);  // floor(2^18 / 10^4)
+  cpu.cache_bytes = 8ull << 20;    // 2^16 paths
+  EXPECT_EQ(state_memory(s, features, &cpu).wave.samples, 6u);
+  s.wave_size = 50000;  // explicit: 5 samples whatever the device
+  EXPECT_EQ(state_memory(s, features, &cpu).wave.samples, 5u);
+  EXPECT_EQ(state_memory(s, features, &gpu).wave.samples, 5u);
+}
+
 TEST(PackedSize, SplitSceneRendersExactlyAsOne) {
   const Scene s = small_scene(200);
   ClRuntime runtime(select_device(""));

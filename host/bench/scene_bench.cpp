@@ -51,6 +51,7 @@ Wavefront& SceneBench::stages() {
   if (!stages_) {
     RenderSettings s = bench_settings(false);
     s.fused = false;  // the split stages are what the stage benchmarks time, one at a time
+    s.wave_size = wave_paths_;  // sample 0 of the whole image, whatever a render's wave would be
     stages_ = std::make_unique<Wavefront>(*env().runtime, scene_, bvh_, s);
     wave_paths_ = static_cast<std::uint32_t>(stages_->wave_size());
     capture();

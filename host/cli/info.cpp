@@ -35,6 +35,10 @@ void add_info_options(CLI::App* info, InfoOptions& o) {
   info->add_flag("--no-bvh-build", o.no_bvh_build,
                  "Build no BVH that is not in the cache: its sizes are then a lower bound "
                  "(reported as an estimate)");
+  info->add_option("--device", o.device,
+                   "The OpenCL device a render would run on (index or name substring, as render "
+                   "takes it), for the size of its wave: a CPU device's fits its cache [default: "
+                   "none looked up; a GPU's wave, the largest]");
   info->add_flag("--json", o.json, "One JSON object on stdout instead of the report");
 }
 
@@ -102,7 +106,13 @@ SceneInfo scene_info(const Scene& scene, const InfoOptions& options,
   info.features = SceneFeatures::of(scene, false);
   info.settings.width = options.width;
   info.settings.height = options.height;
-  info.state = state_memory(info.settings, info.features);
+  if (options.device.empty()) {
+    info.state = state_memory(info.settings, info.features);
+  } else {
+    const DeviceEntry device = select_device(options.device);
+    info.state = state_memory(info.settings, info.features, &device);
+    info.wave_device = device.name;
+  }
 
   SceneCounts counts = scene_counts(scene, nullptr, info.features.texture_lod);
   counts.vertex_arrays = VertexArrays::of(info.features);

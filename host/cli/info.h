@@ -37,6 +37,7 @@ struct InfoOptions {
   bool spatial_splits = false;
   bool no_bvh_build = false;
   bool json = false;
+  std::string device;  // --device: the wave's device (auto_wave_paths); empty: a GPU's wave
 };
 
 void add_info_options(CLI::App* info, InfoOptions& options);
@@ -67,6 +68,7 @@ struct SceneInfo {
   SceneFeatures features;
   RenderSettings settings;  // the render's defaults but width and height
   StateMemory state;
+  std::string wave_device;    // the device whose wave `state` holds (--device); empty: a GPU's
   std::vector<BvhInfo> bvhs;  // 8-wide (CPUs' default) first, then 2-wide (GPUs')
 };
 

@@ -158,7 +158,9 @@ void text_memory(std::ostringstream& o, const SceneInfo& info) {
   });
   line(o, "", "render's BVH layout: 8-wide on CPU devices, 2-wide on GPUs (--bvh-width)");
   line(o, "",
-       "a wave: " + std::to_string(m.wave.pixels) + " pixels x " + std::to_string(m.wave.samples) +
+       std::string(info.wave_device.empty() ? "a GPU's wave (--device for another's)"
+                                            : "a wave on " + info.wave_device) +
+           ": " + std::to_string(m.wave.pixels) + " pixels x " + std::to_string(m.wave.samples) +
            " sample(s) = " + std::to_string(m.wave.paths()) + " paths");
 }
 

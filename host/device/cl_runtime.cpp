@@ -104,6 +104,7 @@ std::vector<DeviceEntry> enumerate_devices() {
       e.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
       e.global_memory = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
       e.max_alloc = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+      e.cache_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_CACHE_SIZE>();
       out.push_back(std::move(e));
     }
   }

@@ -22,6 +22,7 @@ struct DeviceEntry {
   unsigned compute_units = 0;
   unsigned long long global_memory = 0;  // bytes
   unsigned long long max_alloc = 0;      // bytes
+  unsigned long long cache_bytes = 0;    // CL_DEVICE_GLOBAL_MEM_CACHE_SIZE (PoCL: the last level)
 };
 
 // Every device of every platform, numbered in platform order. Empty when there is no OpenCL

@@ -404,8 +404,8 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
   const auto start = std::chrono::steady_clock::now();
   bvh::BuildOptions bvh_options = options.bvh;
   bvh_options.width = bvh_width(runtime.device(), settings);
-  check_state_memory(state_memory(settings, render_features(scene, settings)), settings,
-                     runtime.device());
+  check_state_memory(state_memory(settings, render_features(scene, settings), &runtime.device()),
+                     settings, runtime.device());
   const auto step = [&](const std::string& what) {
     if (options.setup_step) options.setup_step(what);
   };

@@ -66,18 +66,31 @@ std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings
   return device.max_alloc ? device.max_alloc : kSceneBufferReach;
 }
 
-WaveShape wave_shape(const RenderSettings& settings) {
+WaveShape wave_shape(const RenderSettings& settings, std::size_t auto_paths) {
   const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
+  const std::size_t size = settings.wave_size ? settings.wave_size : auto_paths;
   WaveShape wave;
-  wave.pixels = std::min(pixels, settings.wave_size ? settings.wave_size : std::size_t(1) << 20);
-  const std::size_t multi = settings.wave_size ? settings.wave_size : kMultiSamplePaths;
+  wave.pixels = std::min(pixels, size ? size : std::size_t(1) << 20);
+  const std::size_t multi = size ? size : kMultiSamplePaths;
   wave.samples = std::max<std::size_t>(1, multi / wave.pixels);
   return wave;
 }
 
-StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features) {
+std::size_t auto_wave_paths(const DeviceEntry* device, std::size_t bytes_per_path) {
+  if (!device || device->gpu || device->cache_bytes == 0 || bytes_per_path == 0) return 0;
+  const std::size_t fit = static_cast<std::size_t>(device->cache_bytes / bytes_per_path);
+  std::size_t paths = std::size_t(1) << 16;
+  while (paths < (std::size_t(1) << 20) && paths * 2 <= fit) paths *= 2;
+  return paths;
+}
+
+StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features,
+                         const DeviceEntry* device) {
   StateMemory m;
-  m.wave = wave_shape(settings);
+  const std::size_t per_path =
+      path_state_layout(1, settings.aov, features, settings.fused).bytes_per_path +
+      WP_QUEUE_COUNT * sizeof(dev::uint);
+  m.wave = wave_shape(settings, auto_wave_paths(device, per_path));
   m.path_state = path_state_layout(m.wave.paths(), settings.aov, features, settings.fused);
   m.queues = std::uint64_t(WP_QUEUE_COUNT) * m.wave.paths() * sizeof(dev::uint);
   m.counters = WP_COUNTER_COUNT * sizeof(dev::uint);
@@ -107,9 +120,6 @@ Wavefront::Wavefront(ClRuntime& runtime, Scene& scene, bvh::Bvh& bvh,
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings, Scene* owned_scene, bvh::Bvh* owned_bvh)
     : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
-  const WaveShape wave = wave_shape(settings);
-  wave_size_ = wave.pixels;
-  samples_per_wave_ = wave.samples;
   // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
   // of it) and compiles every kernel again for each new one, seconds each time.
   local_size_ = settings.local_size ? settings.local_size : 64;
@@ -152,7 +162,9 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   if (shade_packet_ > 1) options_ += " -D WP_SHADE_PACKET=1";
   const bool forced = !pocl_cpu && (shade_packet_ > 1 || shadow_packet_ > 1 || closest_packet_ > 1);
   if (forced) options_ += " -D WP_PACKETS_FORCED=1";
-  memory_ = state_memory(settings, features_);
+  memory_ = state_memory(settings, features_, &device);
+  wave_size_ = memory_.wave.pixels;
+  samples_per_wave_ = memory_.wave.samples;
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
   try {
@@ -459,10 +471,13 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
   // allocate_state). The nonfinite counter after them is not written: it persists (so Oclgrind
   // would call it uninitialised, were count_nonfinite ever reached; it must not be).
   last_shadow_rays_ = 0;  // launch() sets it where the bounce has shadow rays
+  // The write does not wait (the queue runs in order): the host would otherwise sit out the last
+  // bounce's trace_shadow, and the device the host's next launches.
+  bounce_counts_.fill(0u);
+  bounce_counts_[p.queue_in] = rays;
+  rt_.queue().enqueueWriteBuffer(counters_, CL_FALSE, 0, bounce_counts_.size() * sizeof(dev::uint),
+                                 bounce_counts_.data());
   QueueCounts counts{};
-  counts[p.queue_in] = rays;
-  rt_.queue().enqueueWriteBuffer(counters_, CL_TRUE, 0, counts.size() * sizeof(dev::uint),
-                                 counts.data());
   // The bounce's one read-back, before the first step launched over an exact queue length; the
   // steps from there on push to no queue (pipeline.h), so it holds the next bounce's ray count.
   bool read = false;

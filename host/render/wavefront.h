@@ -71,9 +71,10 @@ struct RenderSettings {
   int camera = -1;            // index into Scene::cameras; -1: the first, or a framing camera
   View view;                  // a camera placed from the command line, field of view, lens (view.h)
   bool all_features = false;  // build every kernel feature regardless of the scene
-  // Path slots per wave; 0: min(pixels, 2^20), or for an image of fewer than kMultiSamplePaths
-  // pixels, as many whole samples of it as fit in kMultiSamplePaths. A size above the pixel count
-  // also holds several samples (its quotient by the pixel count).
+  // Path slots per wave; 0: the device's (auto_wave_paths) on a CPU device, else min(pixels, 2^20),
+  // or for an image of fewer than kMultiSamplePaths pixels, as many whole samples of it as fit in
+  // kMultiSamplePaths. A size above the pixel count also holds several samples (its quotient by
+  // the pixel count).
   std::size_t wave_size = 0;
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
@@ -117,12 +118,21 @@ constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
 
 // The paths of one wave for `settings` (RenderSettings::wave_size): `pixels` pixels, `samples`
-// samples of each.
+// samples of each. Without a wave size, `auto_paths` of them where it is not 0, as if it were the
+// wave size; else min(pixels, 2^20) pixels, several samples of a small image (kMultiSamplePaths).
 struct WaveShape {
   std::size_t pixels = 0, samples = 1;
   std::size_t paths() const { return pixels * samples; }
 };
-WaveShape wave_shape(const RenderSettings& settings);
+WaveShape wave_shape(const RenderSettings& settings, std::size_t auto_paths = 0);
+
+// The paths of a wave by default on `device` (null: unknown) for paths of `bytes_per_path` bytes
+// of path state and queue slots: on a CPU device the largest power of two of them whose state fits
+// the device's global memory cache (CL_DEVICE_GLOBAL_MEM_CACHE_SIZE, the last-level cache on
+// PoCL), kept within [2^16, 2^20], so that every bounce's stages find the paths in the cache
+// (docs/performance.md, "Waves that fit the cache"); 0 for a GPU or a device that reports no
+// cache: wave_shape's other rule.
+std::size_t auto_wave_paths(const DeviceEntry* device, std::size_t bytes_per_path);
 
 // The device memory a Wavefront allocates besides the packed scene, for `settings` and a program
 // of `features` (they decide the path state's optional fields).
@@ -134,7 +144,9 @@ struct StateMemory {
   std::uint64_t film = 0;      // the film's fixed-point sums (kernels/shared/film.h)
   std::uint64_t total() const { return path_state.bytes + queues + counters + film; }
 };
-StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features);
+// `device`: the one the wave runs on (auto_wave_paths), null for wave_shape's rule without it.
+StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features,
+                         const DeviceEntry* device = nullptr);
 
 // The kernel features a render of `scene` compiles in: all of them with settings.all_features,
 // else those the scene (and settings.environment) uses; without texture_lod under --mipmaps off.
@@ -309,6 +321,9 @@ class Wavefront {
                     std::size_t bounce, int mode, std::uint32_t rays);
   cl::Event last_intersect_, last_shadow_;  // the latest launches, for time_packets
   std::uint32_t last_shadow_rays_ = 0;      // the shadow rays of the latest run_bounce
+  // The counters run_bounce writes without waiting: read by the device before the bounce's
+  // blocking read-back returns, left alone until then.
+  QueueCounts bounce_counts_{};
   std::size_t waves_run_ = 0;  // run_wave's count: the first wave (a cold start) is not timed
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;
