@@ -439,9 +439,10 @@ TEST(PackedSize, ImageMemoryIsChecked) {
 // split over several buffers, renders bit for bit as in one, with either BVH layout.
 // A CPU device's default wave is the largest power of two of paths whose path state and queue
 // slots fit its global memory cache, within [2^16, 2^20], swept across each power's threshold;
-// a GPU, or a device that reports no cache, keeps min(pixels, 2^20) pixels (several samples of an
-// image under kMultiSamplePaths pixels). An explicit --wave-size wins over both, and the
-// Wavefront and the memory check see the same wave (state_memory with the device).
+// a larger image is split evenly into the nearest whole number of such waves; a GPU, or a device
+// that reports no cache, keeps min(pixels, 2^20) pixels (several samples of an image under
+// kMultiSamplePaths pixels). An explicit --wave-size wins over both, and the Wavefront and the
+// memory check see the same wave (state_memory with the device).
 TEST(WaveShape, CpuWavesFitTheCache) {
   DeviceEntry cpu;
   cpu.gpu = false;
@@ -470,9 +471,19 @@ TEST(WaveShape, CpuWavesFitTheCache) {
   const SceneFeatures features;   // the fused 112-byte state (PathState test below)
   cpu.cache_bytes = 32ull << 20;  // 2^18 paths of 128 bytes
   StateMemory m = state_memory(s, features, &cpu);
-  EXPECT_EQ(m.wave.pixels, 262144u);
+  EXPECT_EQ(m.wave.pixels, 230400u);  // 921600 pixels: 3.5 waves of 2^18, so 4 even ones
   EXPECT_EQ(m.wave.samples, 1u);
   EXPECT_EQ(m.path_state.bytes_per_path, 112u);
+  // The nearest whole number of waves: up to 1.5 waves' pixels stay one wave, from there two.
+  s.width = 393215, s.height = 1;  // 1.5 x 2^18 - 1
+  EXPECT_EQ(state_memory(s, features, &cpu).wave.pixels, 393215u);
+  s.width = 393216;  // 1.5 x 2^18: two waves
+  EXPECT_EQ(state_memory(s, features, &cpu).wave.pixels, 196608u);
+  s.width = 393217;  // the second wave one pixel short
+  EXPECT_EQ(state_memory(s, features, &cpu).wave.pixels, 196609u);
+  s.width = 640, s.height = 480;  // 1.17 waves: one
+  EXPECT_EQ(state_memory(s, features, &cpu).wave.pixels, 307200u);
+  s.width = 1280, s.height = 720;
   m = state_memory(s, features, &gpu);
   EXPECT_EQ(m.wave.pixels, 921600u);
   EXPECT_EQ(m.wave.samples, 1u);

@@ -312,7 +312,8 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
       "--wave-size", settings.wave_size,
       "Path slots per wave; above the image's pixel count a wave holds several samples "
       "[default: on a CPU device the largest power of two of paths whose state fits its "
-      "cache, 2^16 to 2^20; on a GPU min(pixels, 2^20), 2^18 for small images]");
+      "cache, 2^16 to 2^20, the image split evenly into the nearest whole number of such waves; "
+      "on a GPU min(pixels, 2^20), 2^18 for small images]");
   app->add_option("--bvh-width", settings.bvh_width,
                   "BVH layout: 2 (binary) or 8 (wide, float8 box tests) [default: 2 on GPUs, "
                   "8 on CPUs]");

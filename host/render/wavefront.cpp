@@ -70,6 +70,13 @@ WaveShape wave_shape(const RenderSettings& settings, std::size_t auto_paths) {
   const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
   const std::size_t size = settings.wave_size ? settings.wave_size : auto_paths;
   WaveShape wave;
+  if (!settings.wave_size && auto_paths && pixels > auto_paths) {
+    // The nearest whole number of waves of auto_paths, the pixels spread evenly over them: no
+    // short last wave paying a whole wave's launches, and an image up to 1.5 waves in one.
+    const std::size_t waves = std::max<std::size_t>(1, (pixels + auto_paths / 2) / auto_paths);
+    wave.pixels = (pixels + waves - 1) / waves;
+    return wave;
+  }
   wave.pixels = std::min(pixels, size ? size : std::size_t(1) << 20);
   const std::size_t multi = size ? size : kMultiSamplePaths;
   wave.samples = std::max<std::size_t>(1, multi / wave.pixels);

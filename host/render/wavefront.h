@@ -71,10 +71,10 @@ struct RenderSettings {
   int camera = -1;            // index into Scene::cameras; -1: the first, or a framing camera
   View view;                  // a camera placed from the command line, field of view, lens (view.h)
   bool all_features = false;  // build every kernel feature regardless of the scene
-  // Path slots per wave; 0: the device's (auto_wave_paths) on a CPU device, else min(pixels, 2^20),
-  // or for an image of fewer than kMultiSamplePaths pixels, as many whole samples of it as fit in
-  // kMultiSamplePaths. A size above the pixel count also holds several samples (its quotient by
-  // the pixel count).
+  // Path slots per wave; 0: the device's (auto_wave_paths, wave_shape) on a CPU device, else
+  // min(pixels, 2^20), or for an image of fewer than kMultiSamplePaths pixels, as many whole
+  // samples of it as fit in kMultiSamplePaths. A size above the pixel count also holds several
+  // samples (its quotient by the pixel count).
   std::size_t wave_size = 0;
   std::size_t local_size = 0;  // work-group size; 0: 64
   bool profile = false;        // time every kernel launch with profiling events
@@ -118,8 +118,10 @@ constexpr std::size_t kMultiSamplePaths = std::size_t(1) << 18;
 std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings);
 
 // The paths of one wave for `settings` (RenderSettings::wave_size): `pixels` pixels, `samples`
-// samples of each. Without a wave size, `auto_paths` of them where it is not 0, as if it were the
-// wave size; else min(pixels, 2^20) pixels, several samples of a small image (kMultiSamplePaths).
+// samples of each. Without a wave size and with `auto_paths` (not 0): an image of more pixels in
+// the nearest whole number of waves of auto_paths, evenly (at least one), a smaller one in whole
+// samples up to auto_paths paths; without either, min(pixels, 2^20) pixels, several samples of a
+// small image (kMultiSamplePaths).
 struct WaveShape {
   std::size_t pixels = 0, samples = 1;
   std::size_t paths() const { return pixels * samples; }
