@@ -435,14 +435,11 @@ TEST(PackedSize, ImageMemoryIsChecked) {
                 "dev (CL_DEVICE_GLOBAL_MEM_SIZE)");
 }
 
-// The kernels find every array wherever it lies: a textured, lit scene with an environment map,
-// split over several buffers, renders bit for bit as in one, with either BVH layout.
 // A CPU device's default wave is the largest power of two of paths whose path state and queue
 // slots fit its global memory cache, within [2^16, 2^20], swept across each power's threshold;
 // a larger image is split evenly into the nearest whole number of such waves; a GPU, or a device
 // that reports no cache, keeps min(pixels, 2^20) pixels (several samples of an image under
-// kMultiSamplePaths pixels). An explicit --wave-size wins over both, and the Wavefront and the
-// memory check see the same wave (state_memory with the device).
+// kMultiSamplePaths pixels). An explicit --wave-size wins over both.
 TEST(WaveShape, CpuWavesFitTheCache) {
   DeviceEntry cpu;
   cpu.gpu = false;
@@ -498,6 +495,8 @@ TEST(WaveShape, CpuWavesFitTheCache) {
   EXPECT_EQ(state_memory(s, features, &gpu).wave.samples, 5u);
 }
 
+// The kernels find every array wherever it lies: a textured, lit scene with an environment map,
+// split over several buffers, renders bit for bit as in one, with either BVH layout.
 TEST(PackedSize, SplitSceneRendersExactlyAsOne) {
   const Scene s = small_scene(200);
   ClRuntime runtime(select_device(""));
