@@ -29,6 +29,7 @@
 #include "host/util/fnv1a.h"
 #include "host/util/files.h"
 #include "host/util/json.h"
+#include "host/util/parallel.h"
 
 namespace wp {
 
@@ -240,16 +241,22 @@ FilmImages Film::images() const {
   // long double: 64 significant bits, so S and Q (up to 84 and 116 bits) lose at most 2^-64 of
   // themselves, and the variance's cancellation costs less than with double.
   const long double n = info_.samples();
-  for (std::size_t i = 0; i < pixels(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const long double s = static_cast<long double>(sum(i, c)) * 0x1p-32L;      // sum of v
-      const long double q = static_cast<long double>(squares(i, c)) * 0x1p-32L;  // sum of v^2
-      const long double mean = n > 0 ? s / n : 0.0L;
-      // Unbiased sample variance of one sample, divided by n: the variance of the mean.
-      const long double var = n > 1 ? std::max(0.0L, (q - n * mean * mean) / (n - 1)) / n : 0.0L;
-      out.mean[3 * i + c] = static_cast<float>(mean);
-      out.variance[3 * i + c] = static_cast<float>(var);
-    }
+  // Pixels in blocks over the host's threads (x87 arithmetic: ~25 ms for 1280 x 720 on one
+  // core); each pixel's values are its own, so the images do not depend on the threads.
+  constexpr std::size_t kBlock = 16384;
+  parallel_for((pixels() + kBlock - 1) / kBlock, [&](std::size_t b) {
+    const std::size_t end = std::min(pixels(), (b + 1) * kBlock);
+    for (std::size_t i = b * kBlock; i < end; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const long double s = static_cast<long double>(sum(i, c)) * 0x1p-32L;      // sum of v
+        const long double q = static_cast<long double>(squares(i, c)) * 0x1p-32L;  // sum of v^2
+        const long double mean = n > 0 ? s / n : 0.0L;
+        // Unbiased sample variance of one sample, divided by n: the variance of the mean.
+        const long double var = n > 1 ? std::max(0.0L, (q - n * mean * mean) / (n - 1)) / n : 0.0L;
+        out.mean[3 * i + c] = static_cast<float>(mean);
+        out.variance[3 * i + c] = static_cast<float>(var);
+      }
+  });
   if (!info_.aov) return out;
   out.albedo.resize(3 * pixels());
   out.normal.resize(3 * pixels());
