@@ -639,6 +639,48 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
   }
 }
 
+// trace_shadow launched ahead of its queue's count (over an estimate from the wave before, then
+// the rest from where that launch stopped once the count is read back: Wavefront::run_bounce)
+// traces every shadow ray once: the same image bit for bit as launches over the exact count, with
+// estimates far too low (the rest launched at every bounce), about right and too high to need a
+// rest, with and without shadow packets, and with work-groups of 1, 32 and 64 items (the first
+// launch has to stop exactly at its estimate, a whole number of work-groups).
+TEST_F(RenderKnown, ShadowRaysLaunchedAheadAreEachTracedOnce) {
+  const wp::Scene s = busy_scene();
+  wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
+  st.sampler = wp::Sampler::kSobol;
+  st.spp = 4;
+  st.seed = 5;
+  st.wave_size = 1000;  // 13 waves of 64 x 48 x 4 paths: estimates from the wave before
+  st.shadow_ahead = 0.0f;
+  const wp::Rendered exact = wp::render(*runtime_, s, st);
+  EXPECT_EQ(exact.report.shadow_ahead_launches, 0u);
+  const auto& reference = exact.image.rgb;
+  for (const auto& [packets, local, ahead] :
+       std::vector<std::tuple<bool, std::size_t, float>>{{true, 0, 0.3f},
+                                                         {true, 1, 0.3f},
+                                                         {false, 32, 0.3f},
+                                                         {true, 0, 1.03f},
+                                                         {false, 1, 1.03f},
+                                                         {true, 0, 100.0f}}) {
+    SCOPED_TRACE(::testing::Message()
+                 << "packets " << packets << " local " << local << " ahead " << ahead);
+    st.shadow_packets = packets;
+    st.local_size = local;
+    st.shadow_ahead = ahead;
+    const wp::Rendered r = wp::render(*runtime_, s, st);
+    EXPECT_GT(r.report.shadow_ahead_launches, 0u);
+    if (ahead < 1.0f) {
+      EXPECT_GT(r.report.shadow_rest_launches, 0u);
+    } else if (ahead >= 100.0f) {
+      EXPECT_EQ(r.report.shadow_rest_launches, 0u);  // over every ray
+    }
+    ASSERT_EQ(r.image.rgb.size(), reference.size());
+    EXPECT_EQ(0,
+              std::memcmp(r.image.rgb.data(), reference.data(), reference.size() * sizeof(float)));
+  }
+}
+
 // In a scene of untextured Lambertian surfaces the fused kernel shades eight paths per work-item
 // on PoCL's CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path
 // kernel's bit for bit, with every kind of light sample (the lamp's triangles and the constant

@@ -45,7 +45,8 @@ constexpr Step kIntersect{Stage::kIntersectClosest, QueueRole::kRaysIn};
 // other stages are, the work-groups past the queue's end (most of them where few rays find a
 // surface or few lights are visible) cost more than the rays themselves. trace_shadow reads
 // nothing the stages before it change after the shadow ray is made (the bounce for its random
-// numbers travels with the ray).
+// numbers travels with the ray). Wavefront::run_bounce may launch it over an estimate of that
+// count before the count is back, and the rest of the queue after (RenderSettings::shadow_ahead).
 constexpr Step kTraceShadow{Stage::kTraceShadow, QueueRole::kShadow, QueueRole::kNone,
                             QueueRole::kNone, LaunchSize::kQueueLength};
 constexpr Step kAccumulate{Stage::kAccumulate, QueueRole::kNone, QueueRole::kNone, QueueRole::kNone,

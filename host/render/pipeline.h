@@ -53,7 +53,9 @@ enum class LaunchSize {
   kPixels,      // every pixel of the wave (accumulate)
   kRays,        // the bounce's ray count: an upper bound of every bounce queue's length; the
                 // work-items past the queue's end return at once
-  kQueueLength  // exactly its input queue's length, read back from the device first
+  kQueueLength  // exactly its input queue's length, read back from the device first (trace_shadow:
+                // or an estimate launched before the read-back returns and then the rest,
+                // Wavefront::run_bounce)
 };
 
 struct Step {

@@ -445,6 +445,8 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
   r.closest_packets = wavefront.packet_timing();
   r.shadow_packet = wavefront.shadow_packet();
   r.shadow_packets = wavefront.shadow_packet_timing();
+  r.shadow_ahead_launches = wavefront.shadow_ahead_launches();
+  r.shadow_rest_launches = wavefront.shadow_rest_launches();
   out.film = passes.film();
   if (options.checkpoint) {
     options.checkpoint(out.film);

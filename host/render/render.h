@@ -62,6 +62,9 @@ struct RenderReport {
   std::vector<PacketTiming> closest_packets;
   std::uint32_t shadow_packet = 1;  // the same for shadow rays
   std::vector<PacketTiming> shadow_packets;
+  // trace_shadow launched ahead of its queue's count, and for the rest of a queue past such a
+  // launch's estimate (Wavefront::run_bounce, RenderSettings::shadow_ahead); not in the JSON.
+  std::uint64_t shadow_ahead_launches = 0, shadow_rest_launches = 0;
   // The film holds samples [settings.sample_begin, sample_end): all requested, or fewer when the
   // passes stopped early (`stop`).
   std::uint32_t sample_end = 0;

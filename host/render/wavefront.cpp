@@ -423,7 +423,7 @@ void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::u
     p.packet = mode == 1 ? closest_packet_ : 1u;
     p.shadow_packet = shadow_mode == 1 ? shadow_packet_ : 1u;
     const std::uint32_t traced = rays;
-    rays = run_bounce(p, rays);
+    rays = run_bounce(p, rays, static_cast<int>(bounce));
     time_packets(packet_timing_, closest_packet_, last_intersect_, bounce, mode, traced);
     time_packets(shadow_timing_, shadow_packet_, last_shadow_, bounce, shadow_mode,
                  last_shadow_rays_);
@@ -471,7 +471,31 @@ Wavefront::QueueCounts Wavefront::read_queue_counts() {
   return counts;
 }
 
-std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
+// How many shadow-queue entries run_bounce launches trace_shadow over before the queue's count is
+// read back: the share of shadow rays per ray of the same bounce in the last wave, times
+// settings.shadow_ahead, of this bounce's rays (each ray makes at most one shadow ray), rounded
+// up to whole work-groups so that the launch stops exactly there (the kernels skip only entries
+// past the queue's length); 0 where there is no estimate, the setting is 0, or the shadow rays of
+// this bounce index are still being timed (time_packets times one launch per bounce).
+std::uint32_t Wavefront::shadow_ahead_items(const dev::Launch& p, std::uint32_t rays,
+                                            int bounce) const {
+  if (bounce < 0 || !(settings_.shadow_ahead > 0.0f)) return 0;
+  const std::size_t b = static_cast<std::size_t>(bounce);
+  if (b >= shadow_share_.size() || shadow_share_[b] < 0.0) return 0;
+  if (shadow_packet_ > 1) {
+    const std::size_t t = std::min(b, kPacketTimingBounces - 1);
+    if (t >= shadow_timing_.size() || shadow_timing_[t].choice < 0) return 0;
+  }
+  const std::uint64_t unit =
+      std::uint64_t(local_size_) * (p.shadow_packet > 1 ? shadow_packet_ : 1u);
+  const double want = std::ceil(shadow_share_[b] * settings_.shadow_ahead * rays);
+  const std::uint64_t items = std::min<std::uint64_t>(
+      rays, static_cast<std::uint64_t>(std::max(0.0, std::min(want, double(rays)))));
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(
+      (items + unit - 1) / unit * unit, std::uint64_t(0xffffffffu) / unit * unit));
+}
+
+std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays, int bounce) {
   // Empty the surface, shadow and output queues. One write of all queue counters from offset 0,
   // with queue_in's rewritten to the `rays` it already holds, rather than fills of the three: any
   // partial host write makes Oclgrind 21.10 treat the whole counter buffer as uninitialised (see
@@ -490,12 +514,43 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays) {
   bool read = false;
   for (const Step& step : pipeline_.bounce) {
     if (step.size == LaunchSize::kQueueLength && !read) {
-      counts = read_queue_counts();
-      read = true;
+      const std::uint32_t ahead =
+          step.stage == Stage::kTraceShadow ? shadow_ahead_items(p, rays, bounce) : 0;
+      if (ahead == 0) {
+        counts = read_queue_counts();
+        read = true;
+      } else {
+        // The count is read without waiting and trace_shadow launched over the estimate at once,
+        // so the device goes on while the host wakes to the count; then the rest, if any, from
+        // where that launch stopped. Every entry is traced once: the same image.
+        // (Into a member: an exception before the wait leaves the device a place to write.)
+        cl::Event counted;
+        rt_.queue().enqueueReadBuffer(counters_, CL_FALSE, 0,
+                                      ahead_counts_.size() * sizeof(dev::uint),
+                                      ahead_counts_.data(), nullptr, &counted);
+        launch(step.stage, ahead, p);
+        ++shadow_ahead_launches_;
+        counted.wait();
+        counts = ahead_counts_;
+        read = true;
+        const std::uint32_t queued = counts[queue_index(step.in, p)];
+        if (queued > ahead) {
+          dev::Launch rest = p;
+          rest.shadow_first = ahead;
+          launch(step.stage, queued - ahead, rest);
+          ++shadow_rest_launches_;
+        }
+        continue;
+      }
     }
     run_step(step, p, rays, read ? &counts : nullptr);
   }
   if (!read) counts = read_queue_counts();
+  if (bounce >= 0 && rays > 0) {
+    const std::size_t b = static_cast<std::size_t>(bounce);
+    if (shadow_share_.size() <= b) shadow_share_.resize(b + 1, -1.0);
+    shadow_share_[b] = double(counts[WP_QUEUE_SHADOW]) / double(rays);
+  }
   const std::uint32_t next = counts[p.queue_out];
   std::swap(p.queue_in, p.queue_out);
   return next;

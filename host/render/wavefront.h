@@ -92,6 +92,11 @@ struct RenderSettings {
   // Closest-hit rays likewise, where the program has no instances or alpha (the same walk's
   // closest-hit form: the answer does not depend on which rays share a packet).
   bool closest_packets = true;
+  // trace_shadow launched before its queue's length is read back, over this times the share of
+  // shadow rays the same bounce of the last wave had (Wavefront::run_bounce), the rest, if any,
+  // once the length is known; 0: always after the read-back, over the exact length. The same
+  // image; tests set it below 1 so that the rest is launched.
+  float shadow_ahead = 1.03f;
   // The fused shade kernel eight paths per work-item (kernels/integrator/shade_packet.h) on
   // PoCL's CPU devices, in scenes of untextured Lambertian surfaces without instances or AOVs.
   // The same image.
@@ -224,10 +229,15 @@ class Wavefront {
   // The wave loop in steps, for benchmarks that capture a real wavefront: start_wave generates
   // the camera rays of a wave and returns the launch parameters of its first bounce; run_bounce
   // runs one bounce's stages on `rays` queued rays and returns the next bounce's count, leaving
-  // `params` ready for it.
+  // `params` ready for it; with the bounce's index (from 0) trace_shadow may be launched ahead of
+  // its count (RenderSettings::shadow_ahead), without it only after.
   dev::Launch start_wave(std::uint32_t sample, std::uint32_t first_pixel, std::uint32_t count,
                          std::uint32_t samples = 1);
-  std::uint32_t run_bounce(dev::Launch& params, std::uint32_t rays);
+  std::uint32_t run_bounce(dev::Launch& params, std::uint32_t rays, int bounce = -1);
+  // trace_shadow launches made ahead of their queue's count, and those for the rest of a queue
+  // past such a launch's estimate (run_bounce).
+  std::uint64_t shadow_ahead_launches() const { return shadow_ahead_launches_; }
+  std::uint64_t shadow_rest_launches() const { return shadow_rest_launches_; }
   // The whole mutable device state except the film (path state, queues, counters), to replay a
   // stage on the same input many times.
   struct Snapshot {
@@ -326,6 +336,12 @@ class Wavefront {
   // The counters run_bounce writes without waiting: read by the device before the bounce's
   // blocking read-back returns, left alone until then.
   QueueCounts bounce_counts_{};
+  // Shadow rays per ray of each bounce index in the latest wave that counted it (-1: none yet),
+  // for the estimates of run_bounce's ahead launches, and those launches' counts.
+  std::vector<double> shadow_share_;
+  QueueCounts ahead_counts_{};  // the counters read back without waiting, for those launches
+  std::uint64_t shadow_ahead_launches_ = 0, shadow_rest_launches_ = 0;
+  std::uint32_t shadow_ahead_items(const dev::Launch& p, std::uint32_t rays, int bounce) const;
   std::size_t waves_run_ = 0;  // run_wave's count: the first wave (a cold start) is not timed
   double build_seconds_ = 0.0;
   std::size_t binary_bytes_ = 0;

@@ -204,7 +204,9 @@ typedef struct Launch {
   uint packet;        /* intersect_closest's rays per work-item: 1, or WP_PACKET where the program
                          has WP_CLOSEST_PACKET (traverse8_packet.h) */
   uint shadow_packet; /* trace_shadow's: 1, or WP_PACKET where the program has WP_SHADOW_PACKET */
-  uint pad[2];        /* to 64 bytes, a multiple of 16 on every device */
+  uint shadow_first;  /* trace_shadow's first queue entry: 0, or where an earlier launch of the
+                         bounce stopped (Wavefront::run_bounce) */
+  uint pad;           /* to 64 bytes, a multiple of 16 on every device */
 } Launch;
 
 WP_DEV_END
