@@ -488,11 +488,10 @@ std::uint32_t Wavefront::shadow_ahead_items(const dev::Launch& p, std::uint32_t 
   }
   const std::uint64_t unit =
       std::uint64_t(local_size_) * (p.shadow_packet > 1 ? shadow_packet_ : 1u);
+  // At most the bounce's rays (the share is >= 0); a wave's paths are far below 2^32 - unit.
   const double want = std::ceil(shadow_share_[b] * settings_.shadow_ahead * rays);
-  const std::uint64_t items = std::min<std::uint64_t>(
-      rays, static_cast<std::uint64_t>(std::max(0.0, std::min(want, double(rays)))));
-  return static_cast<std::uint32_t>(std::min<std::uint64_t>(
-      (items + unit - 1) / unit * unit, std::uint64_t(0xffffffffu) / unit * unit));
+  const auto items = static_cast<std::uint64_t>(std::min(want, double(rays)));
+  return static_cast<std::uint32_t>((items + unit - 1) / unit * unit);
 }
 
 std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays, int bounce) {
