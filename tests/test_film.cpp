@@ -446,7 +446,7 @@ class FilmCli : public ::testing::Test {
     fs::create_directories(*dir_);
     setup_error_ = new std::string;
     full_ = new wp::test::CliRun(
-        run(render_args() + "--spp 6 -o full.exr -o full.pfm -o full.wpfilm --json"));
+        run(render_args() + "--spp 6 -o full.exr -o full.pfm -o full.wpfilm --variance --json"));
     part_json_ = new std::string;
     const char* ranges[] = {"0:2", "2:4", "4:6"};
     for (int i = 0; i < 3; ++i) {
@@ -514,7 +514,7 @@ std::size_t differing_bits(const std::vector<float>& a, const std::vector<float>
 TEST_F(FilmCli, MergedPartsEqualOneRenderBitForBit) {
   const wp::test::CliRun a =
       run("merge p2.wpfilm p0.wpfilm p1.wpfilm -o m1.exr -o m1.pfm "
-          "-o m1.wpfilm -q");
+          "-o m1.wpfilm --variance -q");
   ASSERT_EQ(a.status, 0) << a.err;
   const wp::test::CliRun b =
       run("merge p1.wpfilm p2.wpfilm p0.wpfilm -o m2.exr -o m2.wpfilm --json");
@@ -530,6 +530,10 @@ TEST_F(FilmCli, MergedPartsEqualOneRenderBitForBit) {
     EXPECT_EQ(differing_bits(m.rgb, full.rgb), 0u) << merged;
   }
   EXPECT_EQ(wp::test::slurp(path("m1.pfm")), wp::test::slurp(path("full.pfm")));
+  // The render writes the mean and variance it made from its film (render()), the merge those of
+  // the merged film (Film::images): the same function of the same sums, so the same files.
+  EXPECT_EQ(wp::test::slurp(path("m1.variance.pfm")), wp::test::slurp(path("full.variance.pfm")));
+  EXPECT_GT(wp::test::slurp(path("full.variance.pfm")).size(), 24u * 16u * 12u);
 
   const Film single = film("full.wpfilm");
   for (const char* merged : {"m1.wpfilm", "m2.wpfilm"}) {

@@ -50,10 +50,11 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 // Writes every output as one set (image_io.h, write_files): images by extension from `film`'s
-// mean, with the layers asked for (--variance, --aov), .wpfilm files from `film` itself, and with
-// `denoiser` (--denoise) the denoised image beside each image output (its EXR without layers).
-// The denoising runs before anything is written: an OIDN error leaves no output.
-void write_outputs(const CliOptions& cli, const wp::Film& film,
+// mean (film_images: film.images(), which a render has made already), with the layers asked for
+// (--variance, --aov), .wpfilm files from `film` itself, and with `denoiser` (--denoise) the
+// denoised image beside each image output (its EXR without layers). The denoising runs before
+// anything is written: an OIDN error leaves no output.
+void write_outputs(const CliOptions& cli, const wp::Film& film, wp::FilmImages film_images,
                    const std::map<std::string, std::string>& exr_attributes,
                    const wp::Denoiser* denoiser) {
   wp::PngOptions png;
@@ -62,7 +63,6 @@ void write_outputs(const CliOptions& cli, const wp::Film& film,
   std::vector<std::string> images;
   for (const auto& o : cli.outputs)
     if (!is_film(o)) images.push_back(o);
-  wp::FilmImages film_images = film.images();
   const wp::ImageRgb image{film.info().width, film.info().height, std::move(film_images.mean)};
   std::vector<wp::ImageLayer> layers;
   if (cli.variance)
@@ -282,7 +282,16 @@ int render_command(const CLI::App& render, CliOptions& cli, wp::RenderSettings& 
   auto attributes = wp::exr_attributes(cli.scene, settings, result.report);
   attributes["wavepath:render_key"] = result.film.info().key;
   if (!cli.variant.empty()) attributes["wavepath:variant"] = cli.variant;
-  write_outputs(cli, result.film, attributes, denoiser ? &*denoiser : nullptr);
+  // One rank's film is the render's, whose mean and variance render() has made already (the
+  // same function of the same sums); merged films and AOVs need theirs.
+  wp::FilmImages images;
+  if (ranks.size() == 1 && !result.film.info().aov) {
+    images.mean = std::move(result.image.rgb);
+    images.variance = std::move(result.variance.rgb);
+  } else {
+    images = result.film.images();
+  }
+  write_outputs(cli, result.film, std::move(images), attributes, denoiser ? &*denoiser : nullptr);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return finish_render(cli, settings, result.report, part, total);
@@ -324,7 +333,8 @@ int merge_command(CliOptions& cli) {
     }
   }
   const wp::FilmInfo& info = merged.info();
-  write_outputs(cli, merged, wp::film_exr_attributes(info), denoiser ? &*denoiser : nullptr);
+  write_outputs(cli, merged, merged.images(), wp::film_exr_attributes(info),
+                denoiser ? &*denoiser : nullptr);
   if (cli.json) {
     std::cout << "{\"parts\":" << parts.size() << ",\"spp\":" << info.samples()
               << ",\"sample_begin\":" << info.sample_begin << ",\"sample_end\":" << info.sample_end
