@@ -10,8 +10,8 @@ Usage:
 With --markdown PAGE the report replaces what lies between the page's lines
 "<!-- bench_report: begin ... -->" and "<!-- bench_report: end -->" (the rest of the page is
 kept; a page without both lines is an error) and adds the commit the figures were measured at
-(--commit; default: `git describe --always --dirty` of this checkout, which should be the one
-wavepath-bench was built from) and a table of the figures against issue 10's targets.
+(--commit; default: `git describe --always` of this checkout, "-dirty" when a tracked file
+outside docs/ is modified; it should be the one wavepath-bench was built from) and a table of the figures against issue 10's targets.
 
 Per scene, a table of the stage kernels (stage, bounce, rays, time per launch, items/s, and for
 the two ray-tracing stages Embree's rays/s on the same rays, embree_ratio = ours / Embree's and
@@ -285,11 +285,20 @@ def report(data, source, page=None, commit=None):
 
 
 def git_commit():
-    """`git describe --always --dirty` of the checkout this script is in, or 'unknown'."""
+    """`git describe --always` of the checkout this script is in, with "-dirty" when a tracked
+    file outside docs/ is modified (the page this script rewrites, and notes beside it, are not
+    what the benchmark ran), or 'unknown'."""
+    here = os.path.dirname(os.path.abspath(__file__))
     try:
-        r = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True,
-                           text=True, cwd=os.path.dirname(os.path.abspath(__file__)), check=True)
-        return r.stdout.strip() or "unknown"
+        r = subprocess.run(["git", "describe", "--always"], capture_output=True, text=True,
+                           cwd=here, check=True)
+        top = subprocess.run(["git", "rev-parse", "--show-toplevel"], capture_output=True,
+                             text=True, cwd=here, check=True).stdout.strip()
+        changed = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--",
+                                  ".", ":(exclude)docs"], capture_output=True, text=True,
+                                 cwd=top, check=True).stdout.strip()
+        commit = r.stdout.strip()
+        return (commit + "-dirty" if changed else commit) or "unknown"
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
 
@@ -329,7 +338,8 @@ def main():
                              "of printing the report")
     parser.add_argument("--commit", metavar="REV",
                         help="with --markdown: the commit wavepath-bench was built from "
-                             "(default: git describe --always --dirty of this checkout)")
+                             "(default: git describe --always of this checkout, -dirty when a "
+                             "tracked file outside docs/ is modified)")
     args = parser.parse_args()
     try:
         if args.json == "-":
