@@ -11,7 +11,8 @@ With --markdown PAGE the report replaces what lies between the page's lines
 "<!-- bench_report: begin ... -->" and "<!-- bench_report: end -->" (the rest of the page is
 kept; a page without both lines is an error) and adds the commit the figures were measured at
 (--commit; default: `git describe --always` of this checkout, "-dirty" when a tracked file
-outside docs/ is modified; it should be the one wavepath-bench was built from) and a table of the figures against issue 10's targets.
+outside docs/ is modified; it should be the one wavepath-bench was built from) and a table of
+the figures against issue 10's targets.
 
 Per scene, a table of the stage kernels (stage, bounce, rays, time per launch, items/s, and for
 the two ray-tracing stages Embree's rays/s on the same rays, embree_ratio = ours / Embree's and
@@ -298,7 +299,9 @@ def git_commit():
                                   ".", ":(exclude)docs"], capture_output=True, text=True,
                                  cwd=top, check=True).stdout.strip()
         commit = r.stdout.strip()
-        return (commit + "-dirty" if changed else commit) or "unknown"
+        if not commit:
+            return "unknown"
+        return commit + "-dirty" if changed else commit
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
 
