@@ -448,6 +448,10 @@ def parse_args(argv):
     p.add_argument("--renderers", default=",".join(RENDERERS),
                    help="comma-separated subset of %s" % ", ".join(RENDERERS))
     p.add_argument("--wavepath", default=os.path.join(REPO, "build", "wavepath"))
+    p.add_argument("--wavepath-sampler", choices=["sobol", "sobol-padded", "independent"],
+                   help="wavepath's --sampler in the sweep (default: its own, sobol); e.g. "
+                        "independent for the cost of a sample like Mitsuba's default sampler's. "
+                        "The reference is rendered as without it")
     p.add_argument("--venv", default=os.path.join(REPO, "build", "peers-venv"))
     p.add_argument("--python", default=sys.executable,
                    help="interpreter the venv is created with (default: this one)")
@@ -502,6 +506,8 @@ def parse_args(argv):
     bad = [r for r in a.renderers if r not in RENDERERS]
     if bad:
         p.error("unknown renderer(s) %s" % ", ".join(bad))
+    if a.wavepath_sampler:
+        LABELS["wavepath"] = "wavepath (%s sampler)" % a.wavepath_sampler
     if a.pbr and ("mitsuba" in a.renderers or "mitsuba-ld" in a.renderers):
         p.error("--pbr: Mitsuba is not converted for glTF materials (--renderers wavepath,cycles)")
     if a.env and not a.pbr:
@@ -641,10 +647,11 @@ def run_one(a, renderer, spp, seed, scene_json, env, name=None):
     out = os.path.join(a.work, "%s-%s.npy" % (renderer, name or spp))
     if renderer == "wavepath":
         pfm = out[:-4] + ".pfm"
+        sampler = ["--sampler", a.wavepath_sampler] if a.wavepath_sampler else []
         t, _, cpu = timed([a.wavepath, "render", a.render_scene, "--width", str(a.width), "--height",
                       str(a.height), "--spp", str(spp), "--seed", str(seed), "--max-depth",
                       str(a.max_depth), "--rr-depth", str(a.rr_depth), "-o", pfm, "--json", "-q"]
-                     + wavepath_scene_args(a))
+                     + sampler + wavepath_scene_args(a))
         return t, al.read_pfm(pfm), cpu
     job = {"scene": scene_json, "spp": spp, "seed": seed, "width": a.width, "height": a.height,
            "max_depth": a.max_depth, "rr_depth": a.rr_depth, "out": out,
