@@ -501,6 +501,29 @@ std::uint32_t Wavefront::shadow_ahead_items(const dev::Launch& p, std::uint32_t 
   return static_cast<std::uint32_t>((items + unit - 1) / unit * unit);
 }
 
+// The bounce's counters are read without waiting and `step` (trace_shadow) launched over `ahead`
+// entries at once, so the device goes on while the host wakes to the count; then the rest, if
+// any, from where that launch stopped. Every entry is traced once: the same image. Returns the
+// counters. (Read into a member: an exception before the wait leaves the device a place to
+// write.)
+Wavefront::QueueCounts Wavefront::launch_ahead(const Step& step, const dev::Launch& p,
+                                               std::uint32_t ahead) {
+  cl::Event counted;
+  rt_.queue().enqueueReadBuffer(counters_, CL_FALSE, 0, ahead_counts_.size() * sizeof(dev::uint),
+                                ahead_counts_.data(), nullptr, &counted);
+  launch(step.stage, ahead, p);
+  ++shadow_ahead_launches_;
+  counted.wait();
+  const std::uint32_t queued = ahead_counts_[queue_index(step.in, p)];
+  if (queued > ahead) {
+    dev::Launch rest = p;
+    rest.shadow_first = ahead;
+    launch(step.stage, queued - ahead, rest);
+    ++shadow_rest_launches_;
+  }
+  return ahead_counts_;
+}
+
 std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays, int bounce) {
   // Empty the surface, shadow and output queues. One write of all queue counters from offset 0,
   // with queue_in's rewritten to the `rays` it already holds, rather than fills of the three: any
@@ -522,32 +545,12 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays, int boun
     if (step.size == LaunchSize::kQueueLength && !read) {
       const std::uint32_t ahead =
           step.stage == Stage::kTraceShadow ? shadow_ahead_items(p, rays, bounce) : 0;
-      if (ahead == 0) {
-        counts = read_queue_counts();
-        read = true;
-      } else {
-        // The count is read without waiting and trace_shadow launched over the estimate at once,
-        // so the device goes on while the host wakes to the count; then the rest, if any, from
-        // where that launch stopped. Every entry is traced once: the same image.
-        // (Into a member: an exception before the wait leaves the device a place to write.)
-        cl::Event counted;
-        rt_.queue().enqueueReadBuffer(counters_, CL_FALSE, 0,
-                                      ahead_counts_.size() * sizeof(dev::uint),
-                                      ahead_counts_.data(), nullptr, &counted);
-        launch(step.stage, ahead, p);
-        ++shadow_ahead_launches_;
-        counted.wait();
-        counts = ahead_counts_;
-        read = true;
-        const std::uint32_t queued = counts[queue_index(step.in, p)];
-        if (queued > ahead) {
-          dev::Launch rest = p;
-          rest.shadow_first = ahead;
-          launch(step.stage, queued - ahead, rest);
-          ++shadow_rest_launches_;
-        }
+      read = true;
+      if (ahead != 0) {
+        counts = launch_ahead(step, p, ahead);
         continue;
       }
+      counts = read_queue_counts();
     }
     run_step(step, p, rays, read ? &counts : nullptr);
   }

@@ -308,6 +308,7 @@ class Wavefront {
   void run_step(const Step& step, const dev::Launch& p, std::uint32_t rays,
                 const QueueCounts* counts = nullptr);
   QueueCounts read_queue_counts();
+  QueueCounts launch_ahead(const Step& step, const dev::Launch& p, std::uint32_t ahead);
   cl::Event launch(Stage stage, std::uint32_t items, const dev::Launch& params);
   std::uint32_t read_counter(std::uint32_t index);
   void collect_profile();
