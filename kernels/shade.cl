@@ -18,9 +18,9 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
 #if WP_SHADE_PACKET
   /* Eight paths per work-item (integrator/shade_packet.h), each shaded as below. */
   uint slots[WP_SHADE_LANES], shadow, survives;
-  const int n = shade_packet(&scene, paths, queues, launch, get_global_id(0) * WP_SHADE_LANES,
-                             slots, &shadow, &survives);
-  queue_push_group2_n(queues, WP_QUEUE_SHADOW, shadow, launch.queue_out, survives, slots, n, scan);
+  shade_packet(&scene, paths, queues, launch, get_global_id(0) * WP_SHADE_LANES, slots, &shadow,
+               &survives);
+  queue_push_group2_lanes(queues, WP_QUEUE_SHADOW, shadow, launch.queue_out, survives, slots, scan);
 #else
   uint slot = 0u;
   bool shadow = false, survives = false;

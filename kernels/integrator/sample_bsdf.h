@@ -8,6 +8,7 @@
 #define WP_INTEGRATOR_SAMPLE_BSDF_H
 
 #include "stage.h"
+#include "integrator/roulette_compact.h"
 #include "ray_cone.h"
 #include "surface.h"
 
@@ -57,34 +58,53 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
 }
 
 #if WP_SHADE_PACKET
-/* sample_next_ray of eight lanes (common.h, shade_packet.h) for the paths in slots[i] whose bit
- * is set in `lanes`: surface s seen at cosine cos_o, hit at distance t along ray_d, throughput
- * beta, (ux, uy) the direction's numbers. */
-WP_LANES_FN void sample_next_ray8(Paths paths, Queues queues, const uint* slots, uint lanes,
-                                  const Surface8* s, float8 cos_o, Float3x8 ray_d, float8 t,
-                                  Float3x8 beta, float8 ux, float8 uy) {
+/* sample_next_ray and then roulette of eight lanes (common.h, shade_packet.h) for the paths in
+ * slots[i] whose bit is set in `lanes`: surface s seen at cosine cos_o, hit at distance t along
+ * ray_d, throughput beta, at `bounce`, (ux, uy) the direction's numbers and u_rr roulette's.
+ * Returns the lanes that survive roulette. */
+WP_LANES_FN uint sample_next_ray8(Paths paths, Queues queues, Launch launch, const uint* slots,
+                                  uint lanes, const Surface8* s, float8 cos_o, Float3x8 ray_d,
+                                  float8 t, Float3x8 beta, uint8 bounce, float8 ux, float8 uy,
+                                  float8 u_rr) {
   float8 pdf;
   int8 valid;
   const Float3x8 wi = bsdf_sample8(s, cos_o, ux, uy, &pdf, &valid);
   const Float3x8 next = {beta.x * s->color.x, beta.y * s->color.y, beta.z * s->color.z};
   const int8 finite = finite3x8(next) && isfinite(pdf);
   const Float3x8 o = surface_spawn8(s, ray_d, t, wi);
+  float eta[8];
+  uint bo[8];
+  vstore8(bounce + 1u, 0, bo);
+#pragma unroll
+  for (int i = 0; i < 8; ++i) {
+    eta[i] = 1.0f;
+    if (!((lanes >> i) & 1u)) continue;
+    const uint slot = slots[i];
+    eta[i] = path_eta_scale(paths, slot);
+    path_set_bounce(paths, slot, bo[i]);
+    if (lane_set(valid, i) && !lane_set(finite, i)) count_nonfinite(queues);
+  }
+  const int8 ok = valid && finite;
+  const Float3x8 zero = {(float8)(0.0f), (float8)(0.0f), (float8)(0.0f)};
+  Float3x8 kept;
+  const uint survives =
+      lanes & (uint)lane_bits8(roulette8(launch, bounce, select3x8(zero, next, ok), vload8(0, eta),
+                                         u_rr, &kept));
 #pragma unroll
   for (int i = 0; i < 8; ++i) {
     if (!((lanes >> i) & 1u)) continue;
     const uint slot = slots[i];
-    if (lane_set(valid, i) && !lane_set(finite, i)) count_nonfinite(queues);
-    if (!lane_set(valid, i) || !lane_set(finite, i)) {
+    if (!lane_set(ok, i)) {
       path_store_throughput(paths, slot, (float3)(0.0f), 0.0f);
       continue;
     }
-    /* a Lambertian sample: eta scale times 1, no flags (no delta lobe) */
-    path_set_eta_scale(paths, slot, path_eta_scale(paths, slot) * 1.0f);
+    /* a Lambertian sample: the eta scale as it was, no flags (no delta lobe) */
     path_set_flags(paths, slot, 0u);
-    path_store_throughput(paths, slot, lane3(next, i), lane_of(pdf, i));
+    path_store_throughput(paths, slot, lane3(kept, i), lane_of(pdf, i));
     path_store_ray_o(paths, slot, lane3(o, i), 0.0f);
     path_store_ray_d(paths, slot, lane3(wi, i), 0.0f);
   }
+  return survives;
 }
 #endif
 

@@ -25,17 +25,17 @@
 
 /* The shading of the paths in entries [first, first + WP_SHADE_LANES) of launch.queue_in, as
  * shade.cl's body shades each: their slots, and in bit i of *shadow and *survives whether path i
- * has a shadow ray and a next ray. Returns how many entries there were. Lanes without a path to
- * scatter compute with another lane's numbers, and their results are dropped. */
-WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues, Launch launch,
-                             uint first, uint* slots, uint* shadow, uint* survives) {
+ * has a shadow ray and a next ray. Lanes without a path to scatter compute with another lane's
+ * numbers, and their results are dropped. */
+WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues, Launch launch,
+                              uint first, uint* slots, uint* shadow, uint* survives) {
   *shadow = 0u, *survives = 0u;
   for (uint i = 0u; i < WP_SHADE_LANES; ++i) {
     uint ahead;
     if (prefetch_slot(queues, launch.queue_in, first + i, &ahead)) shade_prefetch(paths, ahead);
   }
   const int n = queue_get_run(queues, launch.queue_in, first, WP_SHADE_LANES, slots);
-  if (n == 0) return 0;
+  if (n == 0) return;
   /* The hits; a miss is shade_hit's alone. */
   uint hits = 0u, first_hit = 0u;
   for (int i = n - 1; i >= 0; --i) {
@@ -46,7 +46,7 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
       (void)shade_hit(scene, paths, launch, slots[i], &unused);
     }
   }
-  if (hits == 0u) return n;
+  if (hits == 0u) return;
   /* From here on every lane holds a hit: its own, or the first one's. */
   uint sl[WP_SHADE_LANES];
   float4 h[WP_SHADE_LANES], d[WP_SHADE_LANES], b[WP_SHADE_LANES];
@@ -109,7 +109,7 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
 #endif
   /* The paths that scatter: fewer than max_depth events so far. */
   const uint go = hits & (uint)lane_bits8(bounce < (uint8)(launch.max_depth));
-  if (go == 0u) return n;
+  if (go == 0u) return;
   const float8 cos_o = dot3x8(s.ns, neg3x8(ray_d)); /* bsdf_view */
 #if WP_STRATEGY != WP_STRATEGY_BSDF
   if (scene->desc->light_count != 0u) {
@@ -150,11 +150,8 @@ WP_STAGE_FN int shade_packet(const SceneView* scene, Paths paths, Queues queues,
                                    beta, ltri, pmf, lu, light_v);
   }
 #endif
-  sample_next_ray8(paths, queues, slots, go, &s, cos_o, ray_d, t, beta, bsdf_u, bsdf_v);
-  for (int i = 0; i < n; ++i)
-    if ((go >> i) & 1u && roulette(paths, queues, launch, slots[i], lane_of(roulette_u, i)))
-      *survives |= 1u << i;
-  return n;
+  *survives = sample_next_ray8(paths, queues, launch, slots, go, &s, cos_o, ray_d, t, beta, bounce,
+                               bsdf_u, bsdf_v, roulette_u);
 }
 #endif
 
