@@ -649,9 +649,15 @@ TEST_F(RenderKnown, ShadowRaysLaunchedAheadAreEachTracedOnce) {
   const wp::Scene s = busy_scene();
   wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
   st.sampler = wp::Sampler::kSobol;
-  st.spp = 4;
+  st.spp = 16;
   st.seed = 5;
-  st.wave_size = 1000;  // 13 waves of 64 x 48 x 4 paths: estimates from the wave before
+  // Waves of two samples of the whole image (8 waves): estimates from the same pixels in the wave
+  // before. A wave's first bounce queues ~920 shadow rays (counted), so an estimate of 0.3 of them
+  // leaves a rest whether the launch unit is a work-group of single rays (64) or of packets
+  // (64 x 8 = 512 rays), whichever the packet timing (Wavefront::time_packets, waves 2-5) picks on
+  // the machine. (With waves of 1000 pixels the ~350 rays fitted one packet work-group: whether a
+  // rest was launched hung on that timing.)
+  st.wave_size = 2 * std::size_t(kWidth) * kHeight;
   st.shadow_ahead = 0.0f;
   const wp::Rendered exact = wp::render(*runtime_, s, st);
   EXPECT_EQ(exact.report.shadow_ahead_launches, 0u);
