@@ -46,6 +46,12 @@ static inline bool all8(int8 m) {
   return lane_bits8(m) == 0xff;
 }
 
+/* The index of the lowest set bit of a lane mask (bits != 0): the BVH walks' next child, the
+ * queue push's next entry. */
+static inline int lowest_bit(int bits) {
+  return 31 - clz(bits & -bits);
+}
+
 #define WP_PI 3.14159265358979323846f
 #define WP_INV_PI 0.31830988618379067154f
 #define WP_INF INFINITY

@@ -41,11 +41,6 @@ static inline int queue_get_run(Queues qs, uint q, uint first, int count, uint* 
   return n;
 }
 
-/* The index of the lowest set bit of m (m != 0): the count of the bits below it. */
-static inline uint lowest_bit_index(uint m) {
-  return popcount((m & (0u - m)) - 1u);
-}
-
 /* queue_push_group2 (below) for a work-item with several slots: slot i goes to queue qa where
  * bit i of push_a is set and to queue qb where bit i of push_b is set (shade_packet.h), each
  * queue's entries in slot order within the work-item. A group pushes at most WP_GROUP_SIZE * 32
@@ -72,8 +67,8 @@ static inline void queue_push_group2_lanes(Queues qs, uint qa, uint push_a, uint
   uint b = qb * qs.capacity + scan[WP_GROUP_SIZE + 1u] + (rank >> 16);
   /* One step per entry, the set bits lowest first: a test per slot and queue mispredicts where
    * paths end at random (6% of the packet shade at 1280 x 720, docs/performance.md). */
-  for (uint m = push_a; m != 0u; m &= m - 1u) qs.slots[a++] = slots[lowest_bit_index(m)];
-  for (uint m = push_b; m != 0u; m &= m - 1u) qs.slots[b++] = slots[lowest_bit_index(m)];
+  for (uint m = push_a; m != 0u; m &= m - 1u) qs.slots[a++] = slots[lowest_bit((int)m)];
+  for (uint m = push_b; m != 0u; m &= m - 1u) qs.slots[b++] = slots[lowest_bit((int)m)];
 }
 
 /* Two queue_push_group calls (below) in one: slot goes to queue qa where push_a holds and to queue

@@ -120,9 +120,4 @@ static inline float8 max8(float8 a, float8 b) {
   return select(a, b, a < b);
 }
 
-/* The lowest set bit's index (bits != 0). */
-static inline int lowest_bit(int bits) {
-  return 31 - clz(bits & -bits);
-}
-
 #endif /* WP_TRAVERSE8_H */
