@@ -69,9 +69,15 @@ static inline int8 lane_mask8(int bits) {
 }
 
 /* The lanes of `live` whose ray hits triangle j of block b beyond tmin, with each lane's t and
- * barycentrics: block_test's arithmetic (traverse8.h) for one triangle and eight rays. */
+ * barycentrics: block_test's arithmetic (traverse8.h) for one triangle and eight rays. With
+ * `early`, a triangle inside no lane's edges returns at once, before the division (t, u and v
+ * unset): the any-hit walk's choice. The closest-hit walk computes every triangle's distances:
+ * whether any of eight incoherent rays lies inside a triangle is a branch taken at random on a
+ * scene of few large triangles, and its mispredictions cost the Cornell box's bounce rays more
+ * than the divisions they skip (docs/performance.md, "Closest-hit packets without a branch per
+ * triangle"). */
 static inline int8 packet_triangle(const PacketRays* p, __global const TriBlock4* b, int j,
-                                   int8 live, float8* t, float8* u, float8* v) {
+                                   int8 live, bool early, float8* t, float8* u, float8* v) {
   __global const float* v0 = (__global const float*)b->v0;
   __global const float* v1 = (__global const float*)b->v1;
   __global const float* v2 = (__global const float*)b->v2;
@@ -96,7 +102,7 @@ static inline int8 packet_triangle(const PacketRays* p, __global const TriBlock4
   const uint flags = ((__global const uint*)&b->flags)[j];
   const int8 cull = (flags & WP_TRI_CULL_BACKFACE) ? det < 0.0f : (int8)(0);
   const int8 inside = live & ~mixed & (det != 0.0f) & ~cull;
-  if (!any8(inside)) return (int8)(0);
+  if (early && !any8(inside)) return (int8)(0);
   const float8 inv = 1.0f / det;
   *t = (u_ * (p->sz * az) + v_ * (p->sz * bz) + w_ * (p->sz * cz)) * inv;
   *u = v_ * inv, *v = w_ * inv;
@@ -120,7 +126,7 @@ static inline int packet_leaf(const SceneView* scene, const PacketRays* p, int r
     for (int j = 0; j < 4; ++j) {
       if (prim[j] == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
       float8 t, u, v;
-      const int8 in = packet_triangle(p, b + i, j, lane_mask8(live & ~hit), &t, &u, &v);
+      const int8 in = packet_triangle(p, b + i, j, lane_mask8(live & ~hit), true, &t, &u, &v);
       if (!any8(in)) continue;
       hit |= lane_bits8(in & (packet_distance(t, tleaf) < p->tmax));
       if (hit == live) return hit;
@@ -204,11 +210,10 @@ static inline void packet_closest_leaf(const SceneView* scene, const PacketRays*
       const uint pj = prim[j];
       if (pj == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
       float8 t, u, v;
-      const int8 in = packet_triangle(p, b + i, j, live8, &t, &u, &v);
-      if (!any8(in)) continue;
+      const int8 in = packet_triangle(p, b + i, j, live8, false, &t, &u, &v);
       const float8 d = packet_distance(t, tleaf);
+      /* No branch on the lanes taken either (the same reason). */
       const int8 take = in & ((d < h->t) | ((d == h->t) & ((uint8)(pj) < h->tri)));
-      if (!any8(take)) continue;
       h->t = select(h->t, d, take);
       h->u = select(h->u, u, take);
       h->v = select(h->v, v, take);
