@@ -23,6 +23,15 @@
 
 #define WP_SHADE_LANES 8
 
+/* Whether a miss adds nothing: a black background without a map, where shade_hit adds beta * 0
+ * to the radiance, leaving it as it is bit for bit (beta is finite; no AOVs in these programs). */
+static inline bool background_dark(const SceneView* scene) {
+#if WP_FEATURE_ENVIRONMENT
+  if (scene->desc->env_width != 0u) return false;
+#endif
+  return !(max3(scene->desc->background.xyz) > 0.0f);
+}
+
 /* The shading of the paths in entries [first, first + WP_SHADE_LANES) of launch.queue_in, as
  * shade.cl's body shades each: their slots, and in bit i of *shadow and *survives whether path i
  * has a shadow ray and a next ray. Lanes without a path to scatter compute with another lane's
@@ -36,12 +45,13 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
   }
   const int n = queue_get_run(queues, launch.queue_in, first, WP_SHADE_LANES, slots);
   if (n == 0) return;
-  /* The hits; a miss is shade_hit's alone. */
+  /* The hits; a miss is shade_hit's alone, where it adds something. */
+  const bool dark = background_dark(scene);
   uint hits = 0u, first_hit = 0u;
   for (int i = n - 1; i >= 0; --i) {
     if (path_hit_t(paths, slots[i]) < INFINITY) {
       hits |= 1u << i, first_hit = (uint)i;
-    } else {
+    } else if (!dark) {
       Surface unused;
       (void)shade_hit(scene, paths, launch, slots[i], &unused);
     }
