@@ -16,6 +16,11 @@
 #ifndef WP_CLOSEST_PACKET
 #define WP_CLOSEST_PACKET 0
 #endif
+/* The closest-hit packet's triangle lanes taken by mask, without a branch on whether any lies
+ * inside (traverse8_packet.h): the host's choice, for scenes of few large triangles. */
+#ifndef WP_PACKET_MASKED_CLOSEST
+#define WP_PACKET_MASKED_CLOSEST 0
+#endif
 /* The fused shade kernel for eight paths per work-item (integrator/shade_packet.h): the host's
  * choice, for untextured Lambertian scenes. */
 #ifndef WP_SHADE_PACKET

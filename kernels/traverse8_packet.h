@@ -71,11 +71,11 @@ static inline int8 lane_mask8(int bits) {
 /* The lanes of `live` whose ray hits triangle j of block b beyond tmin, with each lane's t and
  * barycentrics: block_test's arithmetic (traverse8.h) for one triangle and eight rays. With
  * `early`, a triangle inside no lane's edges returns at once, before the division (t, u and v
- * unset): the any-hit walk's choice. The closest-hit walk computes every triangle's distances:
- * whether any of eight incoherent rays lies inside a triangle is a branch taken at random on a
- * scene of few large triangles, and its mispredictions cost the Cornell box's bounce rays more
- * than the divisions they skip (docs/performance.md, "Closest-hit packets without a branch per
- * triangle"). */
+ * unset). Without, every triangle's distances are computed: in a scene of few large triangles
+ * (WP_PACKET_MASKED_CLOSEST) whether any of eight incoherent rays lies inside a triangle is a
+ * branch taken at random, and its mispredictions cost the Cornell box's bounce rays more than the
+ * divisions they skip; on a dense mesh the branch is predictable and pays (docs/performance.md,
+ * "Closest-hit packets without a branch per triangle"). */
 static inline int8 packet_triangle(const PacketRays* p, __global const TriBlock4* b, int j,
                                    int8 live, bool early, float8* t, float8* u, float8* v) {
   __global const float* v0 = (__global const float*)b->v0;
@@ -210,10 +210,15 @@ static inline void packet_closest_leaf(const SceneView* scene, const PacketRays*
       const uint pj = prim[j];
       if (pj == 0xffffffffu) continue; /* an unused lane (bvh_layout.h) */
       float8 t, u, v;
-      const int8 in = packet_triangle(p, b + i, j, live8, false, &t, &u, &v);
+      const int8 in = packet_triangle(p, b + i, j, live8, !WP_PACKET_MASKED_CLOSEST, &t, &u, &v);
+#if !WP_PACKET_MASKED_CLOSEST
+      if (!any8(in)) continue;
+#endif
       const float8 d = packet_distance(t, tleaf);
-      /* No branch on the lanes taken either (the same reason). */
       const int8 take = in & ((d < h->t) | ((d == h->t) & ((uint8)(pj) < h->tri)));
+#if !WP_PACKET_MASKED_CLOSEST
+      if (!any8(take)) continue;
+#endif
       h->t = select(h->t, d, take);
       h->u = select(h->u, u, take);
       h->v = select(h->v, v, take);

@@ -105,7 +105,7 @@ def wavepath_options(wavepath, scene, features):
     # WP_CLOSEST_PACKET, WP_SHADE_PACKET) for PoCL's CPU devices only: a GPU's build has none, so
     # neither do these.
     options = re.sub(
-        r" -D WP_(PREFETCH|SHADOW_PACKET|CLOSEST_PACKET|SHADE_PACKET)=\d+", "",
+        r" -D WP_(PREFETCH|SHADOW_PACKET|CLOSEST_PACKET|SHADE_PACKET|PACKET_MASKED_CLOSEST)=\d+", "",
         report["build_options"]
     )
     return options, report["features"]

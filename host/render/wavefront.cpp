@@ -160,6 +160,14 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   closest_packet_ = settings.closest_packets && packets ? 8u : 1u;
   if (shadow_packet_ > 1) options_ += " -D WP_SHADOW_PACKET=1";
   if (closest_packet_ > 1) options_ += " -D WP_CLOSEST_PACKET=1";
+  // In a scene of a few large triangles (at most kMaskedClosestBlocks blocks of four: the Cornell
+  // box's kind) every packet reaches most triangles and whether any lane lies inside one is a coin
+  // toss, so the closest-hit packet takes each triangle's lanes by mask instead of branching on
+  // that; on a dense mesh the branch is predictable and skips the division (docs/performance.md,
+  // "Closest-hit packets without a branch per triangle"). The same hits either way.
+  constexpr std::size_t kMaskedClosestBlocks = 64;
+  if (closest_packet_ > 1 && bvh.blocks.size() <= kMaskedClosestBlocks)
+    options_ += " -D WP_PACKET_MASKED_CLOSEST=1";
   // Shading eight paths per work-item, float8 lanes being paths, where every scattering surface
   // is Lambertian and untextured (kernels/integrator/shade_packet.h says what it needs).
   const SceneFeatures& f = features_;
