@@ -102,8 +102,8 @@ def wavepath_options(wavepath, scene, features):
         fail(f"wavepath failed on {scene['path']}:\n{run.stderr}")
     report = json.loads(run.stdout.strip().splitlines()[-1])
     # The host adds the cache hints (WP_PREFETCH) and packets of rays and paths (WP_SHADOW_PACKET,
-    # WP_CLOSEST_PACKET, WP_SHADE_PACKET) for PoCL's CPU devices only: a GPU's build has none, so
-    # neither do these.
+    # WP_CLOSEST_PACKET and its WP_PACKET_MASKED_CLOSEST, WP_SHADE_PACKET) for PoCL's CPU devices
+    # only: a GPU's build has none, so neither do these.
     options = re.sub(
         r" -D WP_(PREFETCH|SHADOW_PACKET|CLOSEST_PACKET|SHADE_PACKET|PACKET_MASKED_CLOSEST)=\d+", "",
         report["build_options"]
