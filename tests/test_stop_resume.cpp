@@ -98,17 +98,42 @@ class StopResume : public wp::test::FolderTest {
 
 // The first pass of a render always runs; no later one starts once the limit has passed. 1 ms
 // passes before the first pass ends (loading and the OpenCL set-up alone take longer), so
-// exactly one pass is rendered: the samples one wave holds (wave_size paths over the image's 384
-// pixels, several for an image this small).
+// exactly one pass is rendered: the 100 samples a wave of 38,400 paths holds of the image's 384
+// pixels. The wave is set, not the device's: a CPU whose cache gives a wave of 2^20 paths holds
+// all 1000 samples in one pass (it then ends "complete", not "time_limit").
 TEST_F(StopResume, TimeLimitAlwaysRendersTheFirstPass) {
-  const CliRun r = run(scene_args() + "--spp 1000 --time-limit 0.001 --json -q -o t.pfm");
+  const CliRun r =
+      run(scene_args() + "--spp 1000 --wave-size 38400 --time-limit 0.001 --json -q -o t.pfm");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(json_number(r.out, "passes"), 1) << r.out;
-  const double per_wave = std::floor(json_number(r.out, "wave_size") / 384);
-  EXPECT_GT(per_wave, 1) << r.out;
-  EXPECT_EQ(json_number(r.out, "spp"), std::min(per_wave, 1000.0)) << r.out;
+  EXPECT_EQ(json_number(r.out, "wave_size"), 38400) << r.out;
+  EXPECT_EQ(json_number(r.out, "spp"), 100) << r.out;
   EXPECT_NE(r.out.find("\"stop\":\"time_limit\""), std::string::npos) << r.out;
   EXPECT_EQ(json_number(r.out, "spp_requested"), 1000) << r.out;
+}
+
+// WAVEPATH_WAVE_SIZE stands for --wave-size where none is given (the tests' second machine shape,
+// .ci/run): 1000 paths hold two samples of the 384 pixels, so 5 samples take 3 passes; an explicit
+// --wave-size wins over it; a value that is not a whole number in [1, 2^24] is one error line.
+TEST_F(StopResume, EnvironmentWaveSizeStandsForTheOption) {
+  CliRun r = wp::test::run_wavepath(dir_, scene_args() + "--spp 5 --json -q -o t.pfm",
+                                    "WAVEPATH_WAVE_SIZE=1000");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json_number(r.out, "wave_size"), 768) << r.out;
+  EXPECT_EQ(json_number(r.out, "passes"), 3) << r.out;
+  r = wp::test::run_wavepath(dir_, scene_args() + "--spp 5 --wave-size 384 --json -q -o t.pfm",
+                             "WAVEPATH_WAVE_SIZE=1000");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json_number(r.out, "passes"), 5) << r.out;
+  for (const char* bad : {"0", "-5", "12x", "16777217"}) {
+    r = wp::test::run_wavepath(dir_, scene_args() + "--spp 5 -q -o bad.pfm",
+                               std::string("WAVEPATH_WAVE_SIZE=") + bad);
+    EXPECT_EQ(r.status, 1) << bad;
+    EXPECT_NE(r.err.find(std::string("WAVEPATH_WAVE_SIZE=") + bad + ": must be a whole number"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "bad.pfm")) << bad;
+  }
 }
 
 // Pixel samples per second are spp x pixels / seconds, also where a pass (a wave) holds several
@@ -116,9 +141,9 @@ TEST_F(StopResume, TimeLimitAlwaysRendersTheFirstPass) {
 // wavepath once did) under-reports by spp / passes. The JSON prints %.6g: each figure within
 // 5e-6 of its value, so the product within 1.1e-5.
 TEST_F(StopResume, SamplesPerSecondCountsPixelSamples) {
-  // --wave-size and the passes 12 samples take: 2^18 slots (the default) hold all 12, 384 one.
+  // --wave-size and the passes 12 samples take: 4608 slots hold all 12, 384 one.
   for (const auto& [wave, passes] : std::vector<std::pair<std::string, int>>{
-           {"", 1}, {"--wave-size 384 ", 12}, {"--wave-size 1536 ", 3}}) {
+           {"--wave-size 4608 ", 1}, {"--wave-size 384 ", 12}, {"--wave-size 1536 ", 3}}) {
     const CliRun r = run(scene_args() + wave + "--spp 12 --json -q -o t.pfm");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(json_number(r.out, "passes"), passes) << wave << r.out;

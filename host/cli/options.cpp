@@ -121,7 +121,7 @@ void check_options(const CLI::App& render, const CliOptions& cli,
         "--camera " + std::to_string(settings.camera) + ": camera indices start at 0");
   check_exposure(cli);
   check(settings.spp <= (1 << 20), "--spp must be at most 1048576");
-  check(settings.wave_size <= (std::size_t{1} << 24), "--wave-size must be at most 16777216");
+  check(settings.wave_size <= kMaxWaveSize, "--wave-size must be at most 16777216");
   check(settings.local_size <= 1024, "--local-size must be at most 1024");
   const auto seconds = [&](double v, const char* name) {
     check(std::isfinite(v) && v >= 0 && v <= 1e9,

@@ -94,13 +94,31 @@ std::size_t auto_wave_paths(const DeviceEntry* device, std::size_t bytes_per_pat
   return paths;
 }
 
+std::size_t environment_wave_size() {
+  const char* text = std::getenv("WAVEPATH_WAVE_SIZE");
+  if (!text || !*text) return 0;
+  char* end = nullptr;
+  const unsigned long long size = std::strtoull(text, &end, 10);
+  if (*end != '\0' || text[0] == '-' || size == 0 || size > kMaxWaveSize)
+    throw Error(std::string("WAVEPATH_WAVE_SIZE=") + text + ": must be a whole number from 1 to " +
+                std::to_string(kMaxWaveSize));
+  return static_cast<std::size_t>(size);
+}
+
 StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features,
                          const DeviceEntry* device) {
   StateMemory m;
   const std::size_t per_path =
       path_state_layout(1, settings.aov, features, settings.fused).bytes_per_path +
       WP_QUEUE_COUNT * sizeof(dev::uint);
-  m.wave = wave_shape(settings, auto_wave_paths(device, per_path));
+  if (!settings.wave_size) {
+    if (const std::size_t forced = environment_wave_size()) {
+      RenderSettings with_wave = settings;
+      with_wave.wave_size = forced;
+      m.wave = wave_shape(with_wave);
+    }
+  }
+  if (!m.wave.pixels) m.wave = wave_shape(settings, auto_wave_paths(device, per_path));
   m.path_state = path_state_layout(m.wave.paths(), settings.aov, features, settings.fused);
   m.queues = std::uint64_t(WP_QUEUE_COUNT) * m.wave.paths() * sizeof(dev::uint);
   m.counters = WP_COUNTER_COUNT * sizeof(dev::uint);

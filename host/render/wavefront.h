@@ -141,6 +141,15 @@ WaveShape wave_shape(const RenderSettings& settings, std::size_t auto_paths = 0)
 // cache: wave_shape's other rule.
 std::size_t auto_wave_paths(const DeviceEntry* device, std::size_t bytes_per_path);
 
+// The largest --wave-size.
+constexpr std::size_t kMaxWaveSize = std::size_t(1) << 24;
+
+// The environment's WAVEPATH_WAVE_SIZE, the paths of a wave for renders that set no wave size
+// (RenderSettings::wave_size 0) in place of the device's rule: the tests' second machine shape
+// (.ci/run, docs/testing.md) and a tuning aid. 0 when unset or empty; throws wp::Error for a value
+// that is not a whole number in [1, kMaxWaveSize].
+std::size_t environment_wave_size();
+
 // The device memory a Wavefront allocates besides the packed scene, for `settings` and a program
 // of `features` (they decide the path state's optional fields).
 struct StateMemory {
@@ -152,6 +161,7 @@ struct StateMemory {
   std::uint64_t total() const { return path_state.bytes + queues + counters + film; }
 };
 // `device`: the one the wave runs on (auto_wave_paths), null for wave_shape's rule without it.
+// Without a wave size in `settings`, WAVEPATH_WAVE_SIZE (environment_wave_size) is taken as one.
 StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features,
                          const DeviceEntry* device = nullptr);
 
