@@ -264,8 +264,9 @@ static inline float layer_base_scale(const Surface* s, float top, float cos_o, f
  * G 532, B 465 nm. */
 static inline float dispersed_ior(float ior, float dispersion, uint channel) {
   const float lambda = channel == 1u ? 630.0f : channel == 2u ? 532.0f : 465.0f;
-  return fmax(
-      1.0f, ior + (ior - 1.0f) * (dispersion / 20.0f) * (523655.0f / (lambda * lambda) - 1.5168f));
+  const float n =
+      ior + (ior - 1.0f) * (dispersion / 20.0f) * (523655.0f / (lambda * lambda) - 1.5168f);
+  return fmin(fmax(1.0f, n), WP_MAX_IOR); /* within the indices the transport carries */
 }
 /* A surface whose transmission refracts with a wavelength-dependent index. */
 static inline bool bsdf_dispersive(const Surface* s) {

@@ -48,9 +48,14 @@ static inline int wrap_texel(int i, int n, uint mode) {
 
 /* A texture coordinate moved by whole wrap periods (1 for REPEAT, 2 for MIRRORED_REPEAT) into a
  * small range, or clamped just outside [0, 1] for CLAMP_TO_EDGE, so that texel indices computed
- * from it fit an int; wrap_texel then gives the same texels as for the original coordinate. */
+ * from it fit an int; wrap_texel then gives the same texels as for the original coordinate.
+ * Coordinates beyond +-2^24 are taken as +-2^24 first: float32 holds only even integers there,
+ * which both periods map to 0, as they map 2^24, so no finite coordinate's texel changes; an
+ * infinite one (a transform of scale 3e38 times a coordinate above 1) or NaN becomes a texel too
+ * (fmax and fmin return the other operand for NaN), where inf - floor(inf) was NaN. */
 static inline float wrap_reduce(float u, uint mode) {
-  if (mode == WP_WRAP_CLAMP) return clamp(u, -1.0f, 2.0f);
+  if (mode == WP_WRAP_CLAMP) return fmin(fmax(u, -1.0f), 2.0f);
+  u = fmin(fmax(u, -16777216.0f), 16777216.0f);
   if (mode == WP_WRAP_MIRROR) return u - 2.0f * floor(0.5f * u);
   return u - floor(u);
 }

@@ -213,7 +213,8 @@ struct Quad {
 };
 
 std::string quads_gltf(const fs::path& dir, const std::string& name, const std::vector<Quad>& quads,
-                       const std::string& materials, const std::string& light) {
+                       const std::string& materials, const std::string& light,
+                       const std::string& textures = "") {
   std::vector<float> data;
   std::string views, accessors, primitives;
   for (std::size_t q = 0; q < quads.size(); ++q) {
@@ -235,8 +236,21 @@ std::string quads_gltf(const fs::path& dir, const std::string& name, const std::
                  std::to_string(lo[0]) + "," + std::to_string(lo[1]) + "," + std::to_string(lo[2]) +
                  R"(],"max":[)" + std::to_string(hi[0]) + "," + std::to_string(hi[1]) + "," +
                  std::to_string(hi[2]) + "]}";
-    primitives += sep + R"({"attributes":{"POSITION":)" + n + R"(},"material":)" +
+    primitives += sep + R"({"attributes":{"POSITION":)" + n + R"(,"TEXCOORD_0":)" +
+                  std::to_string(quads.size() + q) + R"(},"material":)" +
                   std::to_string(k.material) + "}";
+  }
+  // Every quad's texture coordinates: its corners' (u, v) weights, after all the positions.
+  for (std::size_t q = 0; q < quads.size(); ++q) {
+    const std::size_t offset = data.size() * 4;
+    const float uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (const int c : {0, 1, 2, 0, 2, 3}) {
+      data.push_back(uv[c][0]);
+      data.push_back(uv[c][1]);
+    }
+    views += R"(,{"buffer":0,"byteOffset":)" + std::to_string(offset) + R"(,"byteLength":48})";
+    accessors += R"(,{"bufferView":)" + std::to_string(quads.size() + q) +
+                 R"(,"componentType":5126,"count":6,"type":"VEC2"})";
   }
   std::ofstream(dir / (name + ".bin"), std::ios::binary)
       .write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size() * 4));
@@ -249,8 +263,10 @@ std::string quads_gltf(const fs::path& dir, const std::string& name, const std::
       << R"("accessors":[)" << accessors << R"(],"bufferViews":[)" << views << "],"
       << R"("buffers":[{"byteLength":)" << data.size() * 4 << R"(,"uri":")" << name << R"(.bin"}],)"
       << R"("extensionsUsed":["KHR_materials_emissive_strength","KHR_materials_ior",)"
-      << R"("KHR_materials_transmission","KHR_materials_volume","KHR_lights_punctual"],)"
-      << R"("materials":[)" << materials << "],"
+      << R"("KHR_materials_transmission","KHR_materials_volume","KHR_lights_punctual",)"
+      << R"("KHR_materials_dispersion","KHR_materials_iridescence","KHR_materials_specular",)"
+      << R"("KHR_materials_anisotropy","KHR_materials_clearcoat","KHR_texture_transform"],)"
+      << R"("materials":[)" << materials << "]," << textures
       << R"("extensions":{"KHR_lights_punctual":{"lights":[)" << light << "]}}}";
   return name + ".gltf";
 }
@@ -312,6 +328,88 @@ TEST_F(EdgeCli, ValuesBeyondFloat32AreClampedAndRenderFinite) {
       "--env-intensity");
   expect_error(run("render " + scene + " --env-color 1e30,0,0 -o out.exr"),
                "--env-color must be at most the most radiance wavepath carries", "--env-color");
+}
+
+// Every number the material extensions leave unbounded, at 1e30 and at float32's largest (and
+// beyond it, 1e39, read as FLT_MAX): dispersion, the volume's thickness and attenuation distance,
+// the thin film's thicknesses and index, the specular colour, the anisotropy's rotation, the
+// normal and coat normal textures' scales, a texture transform's offset, rotation and scale, and a
+// point light's range. Each scene renders with no NaN/Inf sample and a finite, non-negative image;
+// the dispersion is clamped with a warning (a dispersion of 1e30 put NaN samples in the film).
+TEST_F(EdgeCli, ExtensionValuesAtTheirEdgesRenderFinite) {
+  wp::ImageRgb texels;
+  texels.width = texels.height = 4;
+  for (int i = 0; i < 16; ++i)
+    texels.rgb.insert(texels.rgb.end(), {0.1f * float(i % 4), 0.9f, 0.5f});
+  wp::write_images({(dir_ / "t.png").string()}, texels, {});
+  const std::string textures = R"("images":[{"uri":"t.png"}],"textures":[{"source":0}],)";
+  for (const std::string v : {"1e30", "3.4e38", "1e39"}) {
+    SCOPED_TRACE(v);
+    const std::string volume = R"("KHR_materials_transmission":{"transmissionFactor":1},)"
+                               R"("KHR_materials_volume":{"thicknessFactor":)" +
+                               v + "}";
+    const std::string materials =
+        R"({"doubleSided":true},)"
+        // 1, 2: dispersion over a common and the largest index
+        R"({"doubleSided":true,"extensions":{)" +
+        volume +
+        R"(,"KHR_materials_dispersion":)"
+        R"({"dispersion":)" +
+        v +
+        "}}},"
+        R"({"doubleSided":true,"extensions":{)" +
+        volume + R"(,"KHR_materials_ior":{"ior":)" + v +
+        R"(},"KHR_materials_dispersion":{"dispersion":)" + v +
+        "}}},"
+        // 3: a thin film of any thickness and index
+        R"({"doubleSided":true,"extensions":{"KHR_materials_iridescence":{"iridescenceFactor":1,)"
+        R"("iridescenceIor":)" +
+        v + R"(,"iridescenceThicknessMinimum":)" + v + R"(,"iridescenceThicknessMaximum":)" + v +
+        R"(,"iridescenceThicknessTexture":)"
+        R"({"index":0}}}},)"
+        // 4: the specular colour over a transmitting and an opaque base
+        R"({"doubleSided":true,"extensions":{"KHR_materials_specular":{"specularColorFactor":[)" +
+        v + "," + v + "," + v +
+        R"(]},"KHR_materials_transmission":{"transmissionFactor":0.5}}},)"
+        // 5: anisotropy at any rotation, with a normal map of any scale
+        R"({"doubleSided":true,"normalTexture":{"index":0,"scale":)" +
+        v +
+        R"(},"pbrMetallicRoughness":{"roughnessFactor":0.3},"extensions":{)"
+        R"("KHR_materials_anisotropy":{"anisotropyStrength":1,"anisotropyRotation":)" +
+        v +
+        "}}},"
+        // 6: a coat with a normal map of any scale
+        R"({"doubleSided":true,"extensions":{"KHR_materials_clearcoat":{"clearcoatFactor":1,)"
+        R"("clearcoatNormalTexture":{"index":0,"scale":)" +
+        v +
+        "}}}},"
+        // 7: a texture transform of any offset, rotation and scale
+        R"({"doubleSided":true,"pbrMetallicRoughness":{"baseColorTexture":{"index":0,)"
+        R"("extensions":{"KHR_texture_transform":{"offset":[)" +
+        v + "," + v + R"(],"rotation":)" + v + R"(,"scale":[)" + v + "," + v +
+        R"(]}}}}},)"
+        // 8: a volume that attenuates over any distance
+        R"({"doubleSided":true,"extensions":{"KHR_materials_transmission":{"transmissionFactor":1},)"
+        R"("KHR_materials_volume":{"thicknessFactor":1,"attenuationDistance":)" +
+        v + R"(,"attenuationColor":[0.5,0.9,0.1]}}})";
+    std::vector<Quad> quads = {{{-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, 0}};
+    for (int m = 1; m <= 8; ++m) {
+      const float x = -1.6f + 0.8f * float((m - 1) % 4), y = m <= 4 ? 0.1f : 0.9f;
+      quads.push_back({{x, y, 0.5f}, {0.7f, 0, 0}, {0, 0.7f, 0}, m});
+    }
+    const std::string scene = quads_gltf(
+        dir_, "edge", quads, materials,
+        R"({"type":"point","color":[1,1,1],"intensity":20,"range":)" + v + "}", textures);
+    const CliRun r = run("render " + scene + " --width 64 --height 48 --spp 16 --json -o out.exr");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(wp::test::json_number(r.out, "nonfinite_samples"), 0) << r.out;
+    EXPECT_NE(r.err.find("wavepath: warning: edge.gltf: material 1 '': dispersion"),
+              std::string::npos)
+        << r.err;
+    const wp::ImageRgb image = wp::read_exr((dir_ / "out.exr").string());
+    ASSERT_EQ(image.rgb.size(), 64u * 48u * 3u);
+    for (const float c : image.rgb) ASSERT_TRUE(std::isfinite(c) && c >= 0.0f) << c;
+  }
 }
 
 }  // namespace

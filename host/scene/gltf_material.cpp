@@ -290,8 +290,13 @@ Material convert_material(const tinygltf::Model& model, int index, TextureTable&
   read_sheen(in, where, textures, out);
   read_anisotropy(in, where, textures, out);
   read_iridescence(in, where, textures, out, warnings);
-  out.dispersion = number_in(extension(in, "KHR_materials_dispersion", where),
-                             "KHR_materials_dispersion", "dispersion", 0.0f, 0.0, INFINITY, where);
+  out.dispersion =
+      float(at_most(number_in(extension(in, "KHR_materials_dispersion", where),
+                              "KHR_materials_dispersion", "dispersion", 0.0f, 0.0, INFINITY, where),
+                    kMaxDispersion, where, "dispersion",
+                    "an Abbe number of 20 / 65536; the kernels' index per wavelength "
+                    "stays within float32",
+                    warnings));
   read_diffuse_transmission(in, where, textures, out);
   return out;
 }

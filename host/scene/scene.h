@@ -36,7 +36,13 @@ constexpr double kMaxRadiance = 18446744073709551616.0;  // 2^64
 // An index of refraction: the kernels form eta^2 (radiance across an interface) and Fresnel's
 // ((eta - 1) / (eta + 1))^2, which at 1e39 (beyond float32) gives inf and NaN; at most 2^16 keeps
 // eta^2 x radiance within 2^96. (No material comes near: diamond 2.42.)
+// The kernels clamp the indices they derive (dispersion's per wavelength) to the same limit,
+// kernels/shared/types.h's WP_MAX_IOR.
 constexpr double kMaxIor = 65536.0;  // 2^16
+// KHR_materials_dispersion's dispersion, 20 / the Abbe number V (glasses: V 20-90, dispersion
+// 0.2-1): at most 2^16 keeps the kernels' (ior - 1) x dispersion / 20 within float32 (ior <= 2^16),
+// the index it gives being clamped to kMaxIor per wavelength; 1e30 made NaN samples.
+constexpr double kMaxDispersion = 65536.0;  // 2^16
 
 enum class AlphaMode : std::uint8_t { kOpaque, kMask, kBlend };
 

@@ -21,6 +21,10 @@
        */
 
 /* Texture wrap modes (TextureRef.meta.y, 8 bits each for S and T). */
+/* The largest index of refraction the transport carries (host/scene/scene.h, kMaxIor): the
+ * loader clamps the files' indices to it, and the kernels the indices they derive (dispersion). */
+#define WP_MAX_IOR 65536.0f
+
 #define WP_WRAP_REPEAT 0u
 #define WP_WRAP_CLAMP 1u
 #define WP_WRAP_MIRROR 2u

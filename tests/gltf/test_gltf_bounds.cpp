@@ -184,16 +184,19 @@ TEST(GltfBounds, ValuesBeyondFloat32AreClampedWithAWarning) {
   const wp::Scene s =
       load(R"({"emissiveFactor":[1,0.5,0],"extensions":{"KHR_materials_emissive_strength":)"
            R"({"emissiveStrength":3.4e38},"KHR_materials_ior":{"ior":1e39},)"
-           R"("KHR_materials_iridescence":{"iridescenceFactor":1,"iridescenceIor":1e30}}})",
+           R"("KHR_materials_iridescence":{"iridescenceFactor":1,"iridescenceIor":1e30},)"
+           R"("KHR_materials_dispersion":{"dispersion":1e30}}})",
            "1e38", "clamped.gltf");
   EXPECT_EQ(s.materials[0].emission, glm::vec3(float(limit), float(limit / 2), 0.0f));
   EXPECT_EQ(s.materials[0].ior, float(wp::kMaxIor));
   EXPECT_EQ(s.materials[0].iridescence_ior, float(wp::kMaxIor));
+  EXPECT_EQ(s.materials[0].dispersion, float(wp::kMaxDispersion));
   EXPECT_EQ(s.lights[0].intensity, glm::vec3(float(limit), float(limit / 2), 0.0f));
   const std::vector<std::string> expected = {
       "material 0 '': emission 3.4e+38 clamped to 1.84467e+19",
       "material 0 '': ior 3.40282e+38 clamped to 65536",
       "material 0 '': iridescenceIor 1e+30 clamped to 65536",
+      "material 0 '': dispersion 1e+30 clamped to 65536",
       "light 0 '': intensity 1e+38 clamped to 1.84467e+19"};
   ASSERT_EQ(s.warnings.size(), expected.size()) << join(s.warnings);
   for (std::size_t i = 0; i < expected.size(); ++i)
@@ -202,10 +205,18 @@ TEST(GltfBounds, ValuesBeyondFloat32AreClampedWithAWarning) {
   const wp::Scene at =
       load(R"({"emissiveFactor":[1,1,1],"extensions":{)"
            R"("KHR_materials_emissive_strength":{"emissiveStrength":1.8446744e19},)"
-           R"("KHR_materials_ior":{"ior":65536}}})",
+           R"("KHR_materials_ior":{"ior":65536},"KHR_materials_dispersion":{"dispersion":65536}}})",
            "1.8446744e19", "at_limits.gltf");
   EXPECT_TRUE(at.warnings.empty()) << join(at.warnings);
   EXPECT_EQ(at.materials[0].ior, 65536.0f);
+  EXPECT_EQ(at.materials[0].dispersion, 65536.0f);
+  // Just above the dispersion's limit: clamped, with its warning.
+  const wp::Scene above = load(
+      R"({"extensions":{"KHR_materials_dispersion":{"dispersion":65537}}})", "0", "above.gltf");
+  EXPECT_EQ(above.materials[0].dispersion, 65536.0f);
+  ASSERT_EQ(above.warnings.size(), 1u) << join(above.warnings);
+  EXPECT_NE(above.warnings[0].find("dispersion 65537 clamped to 65536"), std::string::npos)
+      << above.warnings[0];
 }
 
 }  // namespace
