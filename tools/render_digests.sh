@@ -67,3 +67,27 @@ case_ sheen-specular "$m/GlamVelvetSofa/GlamVelvetSofa.glb" --env-color 1,1,1 --
 case_ anisotropy "$m/AnisotropyRotationTest/AnisotropyRotationTest.glb" --env-color 1,1,1
 case_ iridescence "$m/IridescenceSuzanne/IridescenceSuzanne.glb" --pipeline split
 case_ variant "$m/MaterialsVariantsShoe/MaterialsVariantsShoe.gltf" --variant street --env-color 1,1,1
+# Thin lens, the nearest environment lookup, full-resolution textures and instances.
+case_ cornell-lens scenes/cornell_box.gltf --aperture 0.05 --focus-distance 3
+case_ env_sun-nearest "$f/env_sun.gltf" --env "$f/env_sun.hdr" --env-filter nearest
+case_ helmet-nomip "$m/DamagedHelmet/DamagedHelmet.glb" --env "$assets/env/studio_small_03_1k.hdr" --mipmaps off
+case_ instancing "$m/SimpleInstancing/SimpleInstancing.glb" --env-color 1,1,1
+# Dispersion and diffuse transmission: the Cornell box with its white material made dispersive
+# glass, or half diffusely transmitting (written here from scenes/cornell_box.gltf).
+derive() {  # out, extension JSON for material 0 ("white")
+  python3 - "$1" "$2" <<'PY'
+import json, sys
+out, extensions = sys.argv[1], json.loads(sys.argv[2])
+doc = json.load(open("scenes/cornell_box.gltf"))
+doc["materials"][0].setdefault("extensions", {}).update(extensions)
+doc["extensionsUsed"] = sorted(set(doc.get("extensionsUsed", [])) | set(extensions))
+json.dump(doc, open(out, "w"))
+PY
+}
+derive "$work/dispersion.gltf" '{"KHR_materials_transmission":{"transmissionFactor":1},
+  "KHR_materials_volume":{"thicknessFactor":1},"KHR_materials_ior":{"ior":1.6},
+  "KHR_materials_dispersion":{"dispersion":2}}'
+case_ dispersion "$work/dispersion.gltf"
+derive "$work/diffuse_transmission.gltf" '{"KHR_materials_diffuse_transmission":
+  {"diffuseTransmissionFactor":0.5,"diffuseTransmissionColorFactor":[1,0.5,0.25]}}'
+case_ diffuse-transmission "$work/diffuse_transmission.gltf" --pipeline split
