@@ -51,10 +51,17 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
   return o;
 }
 
-std::string program_source() {
+// The source of a program holding the kernels of `stages`.
+std::string program_source(const std::vector<Stage>& stages) {
   std::vector<std::string> files;
-  for (const char* name : kStageNames) files.push_back(std::string(name) + ".cl");
+  for (const Stage stage : stages) files.push_back(std::string(stage_name(stage)) + ".cl");
   return KernelSources().expand(files);
+}
+
+std::vector<Stage> all_stages() {
+  std::vector<Stage> stages;
+  for (int i = 0; i < kStageCount; ++i) stages.push_back(static_cast<Stage>(i));
+  return stages;
 }
 
 const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
@@ -270,14 +277,22 @@ void Wavefront::allocate_state() {
                                  zero_film.get());
 }
 
-// The program from the stages' sources, built (or taken from the kernel cache), and the kernels of
-// this pipeline made and primed; the other pipeline's are made only if a test or benchmark
-// launches one (kernel()).
+// The program of this pipeline's stages, built (or taken from the kernel cache), and its kernels
+// made and primed. An implementation that compiles every kernel of a program for its binary
+// (PoCL, for the kernel cache) would otherwise compile the split stages for a fused render too, a
+// third of a cold build's time. A test or benchmark that launches a stage of the other pipeline
+// gets it from a program of every stage, built then (kernel()). Not from a program of the other
+// stages alone: PoCL's code for a stage may depend on the program around it (the shared functions
+// inlined or not, and the contractions into FMAs that follow), and the split stages of a program
+// of only those four gave other ray origins than the fused kernel (Stages.ShadeDoesWhatThe...),
+// where in a program of all nine they give the same bits. The source digest covers every stage, so
+// that the render key does not depend on the pipeline.
 void Wavefront::build_program() {
   const auto build_start = std::chrono::steady_clock::now();
-  const std::string source = program_source();
-  source_digest_ = fnv1a64(source.data(), source.size());
-  program_ = rt_.build(source, options_, settings_.kernel_cache_dir);
+  const std::string all = program_source(all_stages());
+  source_digest_ = fnv1a64(all.data(), all.size());
+  program_stages_ = pipeline_.stages();
+  program_ = rt_.build(program_source(program_stages_), options_, settings_.kernel_cache_dir);
   kernel_cached_ = rt_.cached_build();
   for (const Stage stage : pipeline_.stages()) kernel(stage);
   prime_kernels();
@@ -295,8 +310,12 @@ void Wavefront::build_program() {
 cl::Kernel& Wavefront::kernel(Stage stage) {
   cl::Kernel& k = kernels_[static_cast<int>(stage)];
   if (k()) return k;
+  const bool in_program =
+      std::find(program_stages_.begin(), program_stages_.end(), stage) != program_stages_.end();
+  if (!in_program && !other_program_())
+    other_program_ = rt_.build(program_source(all_stages()), options_, settings_.kernel_cache_dir);
   try {
-    k = cl::Kernel(program_, stage_name(stage));
+    k = cl::Kernel(in_program ? program_ : other_program_, stage_name(stage));
     cl_uint arg = set_scene_args(k, 0, scene_);
     k.setArg(arg++, path_buf_);
     k.setArg(arg++, memory_.path_state.layout);

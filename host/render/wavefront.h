@@ -284,8 +284,8 @@ class Wavefront {
   const std::vector<PacketTiming>& shadow_packet_timing() const { return shadow_timing_; }
   std::uint32_t shadow_packet() const { return shadow_packet_; }
   std::string build_options() const { return options_; }
-  // FNV-1a 64 of the program's source (all stage kernels, includes expanded): part of the render
-  // key (render.h), so films of different kernels do not merge.
+  // FNV-1a 64 of every stage kernel's source (includes expanded), whichever pipeline runs: part
+  // of the render key (render.h), so films of different kernels do not merge.
   std::uint64_t source_digest() const { return source_digest_; }
   // Seconds spent building the program and compiling every kernel (see prime_kernels).
   double build_seconds() const { return build_seconds_; }
@@ -369,7 +369,9 @@ class Wavefront {
   std::uint64_t texture_bytes_ = 0, mip_bytes_ = 0;
   int scene_buffer_count_ = 0;
   cl::Buffer path_buf_, queue_slots_, counters_, film_;
-  cl::Program program_;
+  cl::Program program_;                // the pipeline's stages (build_program)
+  std::vector<Stage> program_stages_;  // ... which are these
+  cl::Program other_program_;  // every stage, built by kernel() for another pipeline's stage
   std::array<cl::Kernel, kStageCount> kernels_;  // indexed by Stage; made by kernel()
   cl_uint launch_arg_ = 0;                       // the index of the Launch argument
   std::vector<std::pair<Stage, cl::Event>> pending_events_;
