@@ -25,7 +25,7 @@ PACKAGES=(
   build-essential cmake pkg-config python3 python3-numpy python3-matplotlib
   opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd
   libembree-dev libtinygltf-dev libglm-dev libopenexr-dev libstb-dev libcli11-dev
-  libdraco-dev libmeshoptimizer-dev libwebp-dev
+  libdraco-dev libmeshoptimizer-dev libwebp-dev libpng-dev libjpeg62-turbo-dev zlib1g-dev
   libgtest-dev libbenchmark-dev oclgrind
   clang libclang-rt-14-dev libclc-14 nlohmann-json3-dev
   libopenmpi-dev openmpi-bin

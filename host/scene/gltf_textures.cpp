@@ -1,17 +1,12 @@
 #include "host/scene/gltf_textures.h"
 
-#include <algorithm>
 #include <climits>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <exception>
 #include <string>
 
-#include <stb_image.h>
-#include <webp/decode.h>
-
 #include "host/scene/gltf_json.h"
+#include "host/scene/image_decode.h"
 #include "host/util/error.h"
 #include "host/util/parallel.h"
 
@@ -69,174 +64,6 @@ bool same_use(const TextureRef& a, const TextureRef& b) {
   return a.image == b.image && a.wrap_s == b.wrap_s && a.wrap_t == b.wrap_t &&
          a.nearest == b.nearest && a.mipmaps == b.mipmaps && a.srgb == b.srgb &&
          a.texcoord == b.texcoord && a.row_u == b.row_u && a.row_v == b.row_v;
-}
-
-// A PNG's chunks, walked before stb_image sees the file: every chunk's length must fit in the
-// bytes that follow it, and the image data must be able to hold the image. stb_image allocates
-// an IDAT chunk's claimed length (doubling its buffer up to it) before reading it, so a 42 KB
-// file whose IDAT claimed 2 GB made it allocate 2 GiB (fuzzing); and it allocates the decoded
-// image from IHDR's size. Deflate expands at most 1,032-fold, so the filtered rows,
-// height x (1 + width x bits per pixel / 8) bytes, cannot exceed 1,032 x the IDAT bytes (plus
-// slack for the filter bytes of interlaced passes). Not a PNG (no signature): nothing to check.
-void check_png_chunks(const unsigned char* bytes, std::size_t size, const std::string& what) {
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (size < 8 || std::memcmp(bytes, kSignature, 8) != 0) return;
-  const auto u32 = [&](std::size_t at) {
-    return std::size_t(bytes[at]) << 24 | std::size_t(bytes[at + 1]) << 16 |
-           std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
-  };
-  double row_bits = 0, rows = 0, idat = 0;
-  std::size_t at = 8;
-  while (at < size) {
-    if (size - at < 12) throw Error(what + ": truncated PNG chunk at byte " + std::to_string(at));
-    const std::size_t length = u32(at);
-    if (length > size - at - 12)
-      throw Error(what + ": PNG chunk at byte " + std::to_string(at) + " claims " +
-                  std::to_string(length) + " bytes, more than the file has");
-    const unsigned char* type = bytes + at + 4;
-    if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13) {
-      const unsigned depth = bytes[at + 16], color = bytes[at + 17];
-      const unsigned samples = color == 2 ? 3 : color == 4 ? 2 : color == 6 ? 4 : 1;
-      row_bits = double(u32(at + 8)) * samples * depth;
-      rows = double(u32(at + 12));
-    } else if (std::memcmp(type, "IDAT", 4) == 0) {
-      idat += double(length);
-    } else if (std::memcmp(type, "IEND", 4) == 0) {
-      break;
-    }
-    at += 12 + length;
-  }
-  const double filtered = rows * (1.0 + std::ceil(row_bits / 8.0));
-  if (filtered > 1032.0 * idat + 8.0 * rows + 65536.0) {
-    // As text from the doubles: the rows' size may exceed any integer type (fuzzing: 3e19).
-    char message[128];
-    std::snprintf(message, sizeof message,
-                  "PNG image data of %.0f bytes cannot hold its %.0f bytes of rows", idat,
-                  filtered);
-    throw Error(what + ": " + message);
-  }
-}
-
-// At most 2^28 texels (16384 x 16384; 1 GiB as RGBA), checked before any decoder allocates them.
-void check_texels(int width, int height, const std::string& what) {
-  if (double(width) * double(height) > double(1u << 28))
-    throw Error(what + ": " + std::to_string(width) + " x " + std::to_string(height) +
-                " pixels, more than the 16384 x 16384 a texture may have");
-}
-
-bool is_webp(const unsigned char* bytes, std::size_t size) {
-  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
-}
-
-// A WebP image (EXT_texture_webp) as RGBA8: its header read and its size checked before the
-// texels are allocated, then decoded into them. An animation is refused (a texture is one image).
-void decode_webp(const unsigned char* bytes, std::size_t size, const std::string& what,
-                 Image& out) {
-  int width = 0, height = 0;
-  if (!WebPGetInfo(bytes, size, &width, &height))
-    throw Error(what + ": not a WebP image libwebp can read (bad or truncated header)");
-  WebPBitstreamFeatures features;
-  if (WebPGetFeatures(bytes, size, &features) != VP8_STATUS_OK)
-    throw Error(what + ": not a WebP image libwebp can read (bad or truncated header)");
-  if (features.has_animation)
-    throw Error(what + ": an animated WebP image (a texture is one still image)");
-  if (width <= 0 || height <= 0)
-    throw Error(what + ": WebP image of " + std::to_string(width) + " x " + std::to_string(height) +
-                " pixels");
-  check_texels(width, height, what);
-  const std::size_t row = 4 * std::size_t(width);
-  out.rgba.assign(row * std::size_t(height), 0);
-  if (!WebPDecodeRGBAInto(bytes, size, out.rgba.data(), out.rgba.size(), static_cast<int>(row)))
-    throw Error(what + ": cannot decode the WebP data (corrupt or truncated)");
-  out.width = width;
-  out.height = height;
-}
-
-// A JPEG's Huffman tables (DHT segments), walked before stb_image sees the file: each table may
-// have at most 256 codes. Debian's stb_image (2.27) copies a table's code sizes into a 257-byte
-// array and its values into a 256-byte one without checking the 16 counts' sum, up to 4,080
-// (fuzz_webp: a 40-byte JPEG wrote past both, UBSan). The walk follows the marker segments by
-// their lengths and, after a scan's header, skips entropy-coded bytes to the next marker, as
-// stb_image does; counts past the end of the file read as 0, as stb_image reads them. Not a JPEG:
-// nothing to check.
-void check_jpeg_tables(const unsigned char* bytes, std::size_t size, const std::string& what) {
-  if (size < 2 || bytes[0] != 0xff || bytes[1] != 0xd8) return;
-  const auto byte = [&](std::size_t at) -> std::size_t { return at < size ? bytes[at] : 0; };
-  std::size_t at = 2;
-  while (at + 1 < size) {
-    const std::size_t marker = bytes[at + 1];
-    if (bytes[at] != 0xff || marker == 0xff) {  // entropy-coded data, or a fill byte
-      ++at;
-      continue;
-    }
-    if (marker == 0xd9) break;  // end of image
-    // Markers without a segment: stuffed zero, TEM, SOI, RST0-7.
-    if (marker == 0x00 || marker == 0x01 || marker == 0xd8 || (marker >= 0xd0 && marker <= 0xd7)) {
-      at += 2;
-      continue;
-    }
-    const std::size_t length = byte(at + 2) << 8 | byte(at + 3);
-    if (marker == 0xc4) {
-      for (std::size_t table = at + 4; table < at + 2 + length;) {
-        std::size_t codes = 0;
-        for (std::size_t i = 1; i <= 16; ++i) codes += byte(table + i);
-        if (codes > 256)
-          throw Error(what + ": JPEG Huffman table at byte " + std::to_string(table) + " has " +
-                      std::to_string(codes) + " codes (at most 256)");
-        table += 17 + codes;
-      }
-    }
-    at += 2 + std::max<std::size_t>(length, 2);
-  }
-}
-
-// A JPEG's size against its bytes, before stb_image allocates the pixels (a 613-byte JPEG
-// claiming 16000 x 16000 pixels made it allocate 1 GiB and spend 2 s). Every 8 x 8 block of
-// every component is coded: a baseline scan spends at least 2 bits on a block (a DC difference
-// and an end-of-block code, each at least 1 bit), so at most 256 pixels a byte of luma; a
-// progressive file's first DC scan at least 1 bit (512 pixels a byte). More than 1024 pixels a
-// byte, past the first 2^16, cannot be a whole image. Not a JPEG: nothing to check.
-void check_jpeg_size(const unsigned char* bytes, std::size_t size, int width, int height,
-                     const std::string& what) {
-  if (size < 2 || bytes[0] != 0xff || bytes[1] != 0xd8) return;
-  const double pixels = double(width) * double(height);
-  if (pixels > 1024.0 * double(size) + 65536.0)
-    throw Error(what + ": JPEG data of " + std::to_string(size) + " bytes cannot hold its " +
-                std::to_string(width) + " x " + std::to_string(height) +
-                " pixels (at most 1024 a byte)");
-}
-
-bool is_png_or_jpeg(const unsigned char* bytes, std::size_t size) {
-  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  return (size >= 8 && std::memcmp(bytes, kPng, 8) == 0) ||
-         (size >= 3 && bytes[0] == 0xff && bytes[1] == 0xd8 && bytes[2] == 0xff);
-}
-
-// A PNG or JPEG as RGBA8. Only those two: stb_image would take anything else as one of its other
-// formats, TGA among them, whose header has no signature (fuzzing: 18 bytes read as a 4608 x 47698
-// TGA made it allocate 880 MB and fill it for seconds).
-void decode_stb(const unsigned char* bytes, std::size_t size, const std::string& what, Image& out) {
-  if (!is_png_or_jpeg(bytes, size))
-    throw Error(what +
-                ": not a PNG, JPEG or WebP image (the formats glTF and EXT_texture_webp "
-                "allow)");
-  check_png_chunks(bytes, size, what);
-  check_jpeg_tables(bytes, size, what);
-  int width = 0, height = 0, channels = 0;
-  if (stbi_info_from_memory(bytes, static_cast<int>(size), &width, &height, &channels)) {
-    check_texels(width, height, what);
-    check_jpeg_size(bytes, size, width, height, what);
-  }
-  unsigned char* pixels =
-      stbi_load_from_memory(bytes, static_cast<int>(size), &width, &height, &channels, 4);
-  if (!pixels) {
-    const char* reason = stbi_failure_reason();
-    throw Error(what + ": cannot decode: " + (reason ? reason : "unknown format"));
-  }
-  out.width = width;
-  out.height = height;
-  out.rgba.assign(pixels, pixels + std::size_t(4) * std::size_t(width) * std::size_t(height));
-  stbi_image_free(pixels);
 }
 
 }  // namespace
@@ -409,11 +236,7 @@ void TextureTable::decode() {
   parallel_for(pending_.size(), [&](std::size_t i) {
     const Pending& p = pending_[i];
     try {
-      Image& out = scene_.images[first + i];
-      if (is_webp(p.bytes, p.size))
-        decode_webp(p.bytes, p.size, p.what, out);
-      else
-        decode_stb(p.bytes, p.size, p.what, out);
+      decode_image(p.bytes, p.size, p.what, scene_.images[first + i]);
     } catch (...) {
       errors[i] = std::current_exception();
     }

@@ -1,5 +1,6 @@
-// glTF textures into Scene::images and Scene::textures: image decoding (stb_image, every image to
-// 8-bit RGBA), samplers, textureInfo and KHR_texture_transform. Internal to the glTF loader.
+// glTF textures into Scene::images and Scene::textures: the images materials use, decoded to 8-bit
+// RGBA (image_decode.h), samplers, textureInfo and KHR_texture_transform. Internal to the glTF
+// loader.
 #pragma once
 
 #include <string>

@@ -28,7 +28,8 @@ MAX_SEED = 64 * 1024  # bytes; larger inputs mostly slow the fuzzer down
 
 def png_rgba(width, height, pixel, empty_idat=False):
     """A width x height RGBA8 PNG of one colour; `empty_idat` puts a zero-length IDAT chunk first
-    (valid PNG; stb_image then copies zero bytes to a null pointer, a fuzz finding)."""
+    (valid PNG; stb_image, the decoder before libpng, then copied zero bytes to a null pointer, a
+    fuzz finding)."""
     def chunk(kind, data):
         return struct.pack(">I", len(data)) + kind + data + struct.pack(
             ">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
@@ -141,7 +142,8 @@ def triangle_scene(variant):
             {"attributes": {"POSITION": 5}, "mode": 5},
             {"attributes": {"POSITION": 0, "TEXCOORD_1": 2}, "mode": 6, "material": 0}]}]
     elif variant == "png_idat_too_long":
-        # An IDAT chunk claiming more bytes than the file has (stb_image allocated the claim).
+        # An IDAT chunk claiming more bytes than the file has (stb_image, the decoder before libpng,
+        # allocated the claim).
         doc, buf = triangle_scene("plain")
         png = bytearray(png_rgba(2, 2, (9, 8, 7, 255)))
         png[33:37] = struct.pack(">I", 0x6F71D329)

@@ -1,7 +1,6 @@
-// tinygltf and stb_image compiled from Debian's headers (libtinygltf-dev, libstb-dev,
-// nlohmann-json3-dev) in this build, so the fuzzer sees their coverage and the sanitizers check
-// them, instead of linking the uninstrumented libtinygltf.so and libstb.so. Nothing is copied.
+// tinygltf compiled from Debian's header (libtinygltf-dev, nlohmann-json3-dev) in this build, so
+// the fuzzer sees its coverage and the sanitizers check it, instead of linking the uninstrumented
+// libtinygltf.so. Nothing is copied. TINYGLTF_NO_STB_IMAGE and TINYGLTF_NO_STB_IMAGE_WRITE
+// (CMakeLists.txt) leave stb_image and stb_image_write out: the loader decodes images itself.
 #define TINYGLTF_IMPLEMENTATION
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include <tiny_gltf.h>  // includes stb_image.h and stb_image_write.h, once each
+#include <tiny_gltf.h>

@@ -13,8 +13,9 @@
 #include <draco/mesh/mesh.h>
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
-#include <stb_image.h>
 #include <webp/encode.h>
+
+#include "host/scene/image_decode.h"
 
 namespace wp::test {
 namespace {
@@ -376,12 +377,10 @@ Glb webp_twin(const Glb& in) {
   for (json& image : doc["images"]) {
     const json& view = doc["bufferViews"][image["bufferView"].get<std::size_t>()];
     const unsigned char* bytes = &in.bin.at(view.value("byteOffset", std::size_t{0}));
-    int w = 0, h = 0, channels = 0;
-    unsigned char* rgba =
-        stbi_load_from_memory(bytes, int(view["byteLength"]), &w, &h, &channels, 4);
-    if (!rgba) throw std::runtime_error("stb_image cannot decode a twin's image");
-    const std::vector<unsigned char> webp = webp_lossless(rgba, w, h);
-    stbi_image_free(rgba);
+    wp::Image decoded;
+    decode_image(bytes, view["byteLength"].get<std::size_t>(), "a twin's image", decoded);
+    const std::vector<unsigned char> webp =
+        webp_lossless(decoded.rgba.data(), decoded.width, decoded.height);
     image["bufferView"] = append_view(doc, out.bin, webp.data(), webp.size());
     image["mimeType"] = "image/webp";
   }

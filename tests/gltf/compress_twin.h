@@ -52,8 +52,8 @@ struct MeshoptFilters {
 };
 Glb meshopt_twin(const Glb& in, const MeshoptFilters& filters = {});
 
-// Every image as a lossless WebP (exact RGBA, through stb_image's decoding of the original), the
-// textures' EXT_texture_webp source; the textures' own `source` is dropped.
+// Every image as a lossless WebP (exact RGBA: the texels the loader decodes from the original,
+// wp::decode_image), the textures' EXT_texture_webp source; the textures' own `source` is dropped.
 Glb webp_twin(const Glb& in);
 
 // A lossless WebP of `width` x `height` RGBA8 texels (exact: RGB kept under alpha 0 too).
