@@ -5,6 +5,7 @@
 #   fuzz_environment  wp::load_environment on .hdr (and .exr) bytes
 #   fuzz_draco, fuzz_meshopt, fuzz_webp  wp::load_gltf on a .glb around a compressed payload
 #                     (tests/fuzz/fuzz_compressed.cpp)
+#   fuzz_image        wp::decode_image on PNG, JPEG and WebP bytes (libpng, libjpeg-turbo, libwebp)
 # Seeds: tests/fuzz/make_seeds.py's built-in ones, plus small models and cropped .hdr maps from
 # ../shared/assets (WAVEPATH_ASSETS overrides) when that folder exists; for the compressed data,
 # build-fuzz/make_compressed_seeds compresses a built-in quad and those models (Draco, meshopt,
@@ -52,7 +53,7 @@ usage() {
   exit 2
 }
 seconds=60
-all_targets=(fuzz_gltf fuzz_environment fuzz_draco fuzz_meshopt fuzz_webp)
+all_targets=(fuzz_gltf fuzz_environment fuzz_draco fuzz_meshopt fuzz_webp fuzz_image)
 targets=("${all_targets[@]}")
 if ((run_step)); then
   seconds=${1:-60}
@@ -117,9 +118,10 @@ fuzz() {
 }
 
 # Each target's seed folder, dictionary and largest input.
-# The codecs' targets take no dictionary (their inputs are binary payloads).
+# The codecs' and the image decoders' targets take no dictionary (their inputs are binary).
 declare -A spec=([fuzz_gltf]="gltf gltf.dict 65536" [fuzz_environment]="environment environment.dict 16384"
-  [fuzz_draco]="draco - 65536" [fuzz_meshopt]="meshopt - 65536" [fuzz_webp]="webp - 65536")
+  [fuzz_draco]="draco - 65536" [fuzz_meshopt]="meshopt - 65536" [fuzz_webp]="webp - 65536"
+  [fuzz_image]="image - 65536")
 failed=0
 for t in "${targets[@]}"; do
   # shellcheck disable=SC2086 # the spec is three words

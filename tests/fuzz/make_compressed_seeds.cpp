@@ -5,7 +5,8 @@
 //
 // writes OUT_DIR/gltf/twin_*.glb (whole compressed twins for fuzz_gltf, when under 64 KB),
 // OUT_DIR/draco/, OUT_DIR/meshopt/ and OUT_DIR/webp/ (the payloads with the headers
-// tests/fuzz/fuzz_compressed.cpp reads). Always a built-in quad; with ASSETS_DIR
+// tests/fuzz/fuzz_compressed.cpp reads), and OUT_DIR/image/: JPEGs (grey, RGB and CMYK, baseline
+// and progressive) and a lossless WebP for fuzz_image. Always a built-in quad; with ASSETS_DIR
 // (../shared/assets), also Box, BoxTextured, Duck and DamagedHelmet's compressed data.
 #include <cstdio>
 #include <cstring>
@@ -139,6 +140,16 @@ int main(int argc, char** argv) {
     seeds_of(quad(), "quad", out);
     const unsigned char texels[] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 9, 9, 9, 128};
     seed(out / "webp", "quad.webp", wp::test::webp_lossless(texels, 2, 2));
+    seed(out / "image", "quad.webp", wp::test::webp_lossless(texels, 2, 2));
+    for (const int components : {1, 3, 4})
+      for (const bool progressive : {false, true}) {
+        std::vector<unsigned char> samples;
+        for (int i = 0; i < 24 * 16 * components; ++i)
+          samples.push_back(static_cast<unsigned char>(i * 37 % 251));
+        seed(out / "image",
+             "jpeg" + std::to_string(components) + (progressive ? "_progressive" : "") + ".jpg",
+             wp::test::jpeg_encode(samples, 24, 16, components, progressive));
+      }
     if (argc > 2) {
       for (const char* m : {"Box/Box.glb", "BoxTextured/BoxTextured.glb", "Duck/Duck.glb",
                             "DamagedHelmet/DamagedHelmet.glb"}) {

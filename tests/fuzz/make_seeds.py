@@ -3,12 +3,14 @@
 
     make_seeds.py OUT_DIR [ASSETS_DIR]
 
-Writes OUT_DIR/gltf/ and OUT_DIR/environment/. Built-in seeds are always written: small glTF
-scenes (JSON with data: URIs and the same as .glb) covering the loader's features, the repository's
-own scenes/, and small Radiance .hdr (flat and run-length encoded) and OpenEXR files. With
-ASSETS_DIR (../shared/assets) present, its small .glb files and its .gltf files whose buffers fit in
-a data: URI are added, images replaced by a tiny PNG, and each env/*.hdr cropped to its first
-scanlines (real run-length data, a few KB).
+Writes OUT_DIR/gltf/, OUT_DIR/environment/ and OUT_DIR/image/. Built-in seeds are always written:
+small glTF scenes (JSON with data: URIs and the same as .glb) covering the loader's features, the
+repository's own scenes/, small Radiance .hdr (flat and run-length encoded) and OpenEXR files, and
+PNGs of every colour type and bit depth for fuzz_image (its JPEG seeds come from
+make_compressed_seeds). With ASSETS_DIR (../shared/assets) present, its small .glb files and its
+.gltf files whose buffers fit in a data: URI are added, images replaced by a tiny PNG, each
+env/*.hdr cropped to its first scanlines (real run-length data, a few KB), and its PNG and JPEG
+files under 64 KB as image seeds.
 """
 
 import base64
@@ -324,15 +326,74 @@ def exr(width, height, value, origin=(0, 0), pixels=True):
     return header + table + blocks
 
 
+def png(width, height, color, depth, rows, palette=None, trns=None, interlace=0):
+    """A PNG of colour type `color` and bit depth `depth` from `rows` (each a bytes object of
+    packed samples, filter byte not included); interlaced images take the rows of their passes."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(
+            ">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    body = chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, depth, color, 0, 0, interlace))
+    if palette:
+        body += chunk(b"PLTE", palette)
+    if trns:
+        body += chunk(b"tRNS", trns)
+    raw = b"".join(b"\0" + r for r in rows)
+    return b"\x89PNG\r\n\x1a\n" + body + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+
+
+def builtin_images(out):
+    """fuzz_image's PNGs: every colour type and bit depth the decoder converts, tRNS, Adam7."""
+    w, h = 5, 3
+    seeds = {
+        "grey1": png(w, h, 0, 1, [bytes([0b10110000])] * h),
+        "grey2": png(w, h, 0, 2, [bytes([0b00011011, 0b10000000])] * h, trns=b"\0\2"),
+        "grey4": png(w, h, 0, 4, [bytes([0x1f, 0xa5, 0x70])] * h),
+        "grey16": png(w, h, 0, 16, [bytes(range(2 * w))] * h, trns=b"\x01\x02"),
+        "grey_alpha": png(w, h, 4, 8, [bytes(range(2 * w))] * h),
+        "rgb": png(w, h, 2, 8, [bytes(range(3 * w))] * h, trns=b"\0\0\0\1\0\2"),
+        "rgb16": png(w, h, 2, 16, [bytes(range(6 * w))] * h),
+        "rgba16": png(w, h, 6, 16, [bytes(range(8 * w))] * h),
+        "palette": png(w, h, 3, 4, [bytes([0x01, 0x23, 0x40])] * h,
+                       palette=bytes(range(3 * 5)), trns=b"\x80\x00"),
+        # Adam7 of a 3 x 3 RGBA image: passes 1, 4, 5, 6 and 7 have rows of 1, 1, 2, 1 (two
+        # rows) and 3 pixels; passes 2 and 3 are empty.
+        "adam7": png(3, 3, 6, 8, [bytes(4), bytes(4), bytes(8), bytes(4), bytes(4), bytes(12)],
+                     interlace=1),
+    }
+    for name, data in seeds.items():
+        with open(os.path.join(out, "builtin_%s.png" % name), "wb") as f:
+            f.write(data)
+    return len(seeds)
+
+
+def asset_images(assets, out):
+    """The shared models' PNG and JPEG files under MAX_SEED bytes."""
+    n = 0
+    models = os.path.join(assets, "models")
+    for root, _, files in os.walk(models):
+        for name in sorted(files):
+            if os.path.splitext(name)[1].lower() in (".png", ".jpg", ".jpeg"):
+                path = os.path.join(root, name)
+                if os.path.getsize(path) <= MAX_SEED:
+                    with open(path, "rb") as src, open(
+                            os.path.join(out, "asset_%d_%s" % (n, name.replace(" ", "_"))),
+                            "wb") as dst:
+                        dst.write(src.read())
+                    n += 1
+    return n
+
+
 def main():
     if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
     out = sys.argv[1]
     assets = sys.argv[2] if len(sys.argv) == 3 else None
     gltf_dir, env_dir = os.path.join(out, "gltf"), os.path.join(out, "environment")
-    os.makedirs(gltf_dir, exist_ok=True)
-    os.makedirs(env_dir, exist_ok=True)
+    image_dir = os.path.join(out, "image")
+    for d in (gltf_dir, env_dir, image_dir):
+        os.makedirs(d, exist_ok=True)
     builtin_gltf(gltf_dir)
+    builtin_images(image_dir)
     builtin_hdr(env_dir)
     with open(os.path.join(env_dir, "builtin.exr"), "wb") as f:
         f.write(exr(3, 2, (0.5, 1.0, 2.0)))
@@ -345,7 +406,7 @@ def main():
         f.write(struct.pack("<I4B", 20000630, 2, 0, 0, 0) + b"junk\0opaqueType\0"
                 + struct.pack("<I", 1677721600) + b"x" * 85)
     if assets and os.path.isdir(assets):
-        n = asset_gltf(assets, gltf_dir)
+        n = asset_gltf(assets, gltf_dir) + asset_images(assets, image_dir)
         env = os.path.join(assets, "env")
         for name in sorted(os.listdir(env)) if os.path.isdir(env) else []:
             if name.endswith(".hdr"):

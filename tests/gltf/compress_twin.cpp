@@ -1,6 +1,7 @@
 #include "tests/gltf/compress_twin.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -369,6 +370,42 @@ std::vector<unsigned char> webp_lossless(const unsigned char* rgba, int w, int h
   WebPMemoryWriterClear(&writer);
   if (!ok) throw std::runtime_error("WebP encoding");
   return out;
+}
+
+std::vector<unsigned char> jpeg_encode(const std::vector<unsigned char>& samples, int width,
+                                       int height, int components, bool progressive,
+                                       const std::vector<jpeg_scan_info>& scans) {
+  jpeg_compress_struct c;
+  jpeg_error_mgr errors;
+  c.err = jpeg_std_error(&errors);
+  jpeg_create_compress(&c);
+  unsigned char* buffer = nullptr;
+  unsigned long size = 0;
+  jpeg_mem_dest(&c, &buffer, &size);
+  c.image_width = JDIMENSION(width);
+  c.image_height = JDIMENSION(height);
+  c.input_components = components;
+  c.in_color_space = components == 1 ? JCS_GRAYSCALE : components == 3 ? JCS_RGB : JCS_CMYK;
+  jpeg_set_defaults(&c);
+  jpeg_set_quality(&c, 100, TRUE);  // every quantisation step 1
+  for (int i = 0; i < c.num_components; ++i)
+    c.comp_info[i].h_samp_factor = c.comp_info[i].v_samp_factor = 1;
+  if (progressive) jpeg_simple_progression(&c);
+  if (!scans.empty()) {
+    c.scan_info = scans.data();
+    c.num_scans = static_cast<int>(scans.size());
+  }
+  jpeg_start_compress(&c, TRUE);
+  while (c.next_scanline < c.image_height) {
+    JSAMPROW row = const_cast<JSAMPROW>(samples.data()) +
+                   std::size_t(c.next_scanline) * std::size_t(width * components);
+    jpeg_write_scanlines(&c, &row, 1);
+  }
+  jpeg_finish_compress(&c);
+  jpeg_destroy_compress(&c);
+  std::vector<unsigned char> jpeg(buffer, buffer + size);
+  std::free(buffer);
+  return jpeg;
 }
 
 Glb webp_twin(const Glb& in) {

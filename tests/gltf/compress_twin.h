@@ -10,8 +10,11 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>  // before jpeglib.h, which uses FILE without including it
 #include <string>
 #include <vector>
+
+#include <jpeglib.h>
 
 namespace wp::test {
 
@@ -58,5 +61,14 @@ Glb webp_twin(const Glb& in);
 
 // A lossless WebP of `width` x `height` RGBA8 texels (exact: RGB kept under alpha 0 too).
 std::vector<unsigned char> webp_lossless(const unsigned char* rgba, int width, int height);
+
+// A JPEG of `samples` (rows top down, `components` a texel) from libjpeg's compressor at quality
+// 100 (the tests check the decoder against the texels it was given; the fuzz seeds): `components` 1
+// (grey), 3 (RGB, stored as YCbCr) or 4 (CMYK, stored as Adobe's inverted CMYK); every component at
+// full resolution (4:4:4), so chroma upsampling plays no part in the bounds below. `scans`: the
+// progressive scan script to write, if any.
+std::vector<unsigned char> jpeg_encode(const std::vector<unsigned char>& samples, int width,
+                                       int height, int components, bool progressive,
+                                       const std::vector<jpeg_scan_info>& scans = {});
 
 }  // namespace wp::test

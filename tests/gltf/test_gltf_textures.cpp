@@ -8,6 +8,7 @@
 #include <jpeglib.h>
 #include <zlib.h>
 
+#include "tests/gltf/compress_twin.h"
 #include "tests/gltf/gltf_files.h"
 
 namespace {
@@ -429,46 +430,6 @@ TEST(GltfLoader, PngEveryColourTypeAndBitDepth) {
   }
 }
 
-// A JPEG from libjpeg's compressor (test code may use it: the decoder is checked against the
-// texels it was given): `components` 1 (grey), 3 (RGB, stored as YCbCr) or 4 (CMYK, stored as
-// Adobe's inverted CMYK); every component at full resolution (4:4:4), so chroma upsampling plays no
-// part in the bounds below. `scans`: the progressive scan script to write, if any.
-std::vector<unsigned char> libjpeg_encode(const std::vector<unsigned char>& samples, int width,
-                                          int height, int components, bool progressive,
-                                          const std::vector<jpeg_scan_info>& scans = {}) {
-  jpeg_compress_struct c;
-  jpeg_error_mgr errors;
-  c.err = jpeg_std_error(&errors);
-  jpeg_create_compress(&c);
-  unsigned char* buffer = nullptr;
-  unsigned long size = 0;
-  jpeg_mem_dest(&c, &buffer, &size);
-  c.image_width = JDIMENSION(width);
-  c.image_height = JDIMENSION(height);
-  c.input_components = components;
-  c.in_color_space = components == 1 ? JCS_GRAYSCALE : components == 3 ? JCS_RGB : JCS_CMYK;
-  jpeg_set_defaults(&c);
-  jpeg_set_quality(&c, 100, TRUE);  // every quantisation step 1
-  for (int i = 0; i < c.num_components; ++i)
-    c.comp_info[i].h_samp_factor = c.comp_info[i].v_samp_factor = 1;
-  if (progressive) jpeg_simple_progression(&c);
-  if (!scans.empty()) {
-    c.scan_info = scans.data();
-    c.num_scans = static_cast<int>(scans.size());
-  }
-  jpeg_start_compress(&c, TRUE);
-  while (c.next_scanline < c.image_height) {
-    JSAMPROW row = const_cast<JSAMPROW>(samples.data()) +
-                   std::size_t(c.next_scanline) * std::size_t(width * components);
-    jpeg_write_scanlines(&c, &row, 1);
-  }
-  jpeg_finish_compress(&c);
-  jpeg_destroy_compress(&c);
-  std::vector<unsigned char> jpeg(buffer, buffer + size);
-  std::free(buffer);
-  return jpeg;
-}
-
 // A smooth image: each component a product of slow sines over 40 x 24 texels (the last block
 // column and row partly outside the image).
 std::vector<unsigned char> smooth_samples(int width, int height, int components) {
@@ -501,8 +462,9 @@ TEST(GltfLoader, JpegWithinItsRounding) {
       const std::string name = "jpeg_" + std::to_string(components) + (progressive ? "_prog" : "");
       SCOPED_TRACE(name);
       const std::vector<unsigned char> samples = smooth_samples(w, h, components);
-      const wp::Image got = loaded_image(libjpeg_encode(samples, w, h, components, progressive),
-                                         "image/jpeg", name + ".gltf");
+      const wp::Image got =
+          loaded_image(wp::test::jpeg_encode(samples, w, h, components, progressive), "image/jpeg",
+                       name + ".gltf");
       ASSERT_EQ(got.width, w);
       ASSERT_EQ(got.height, h);
       const int bound = components == 1 ? 5 : components == 3 ? 15 : 10;
@@ -556,7 +518,8 @@ TEST(GltfLoader, BrokenPngAndJpegAreOneError) {
   expect_error(image_gltf(short_data, "image/png", "png_short.gltf"),
                "image 0 'img': cannot decode the PNG: Not enough image data");
 
-  const std::vector<unsigned char> jpeg = libjpeg_encode(smooth_samples(16, 8, 3), 16, 8, 3, false);
+  const std::vector<unsigned char> jpeg =
+      wp::test::jpeg_encode(smooth_samples(16, 8, 3), 16, 8, 3, false);
   for (std::size_t cut = 1; cut < jpeg.size(); ++cut)
     expect_error(image_gltf({jpeg.begin(), jpeg.begin() + std::ptrdiff_t(cut)}, "image/jpeg",
                             "jpeg_cut.gltf"),
@@ -578,7 +541,7 @@ TEST(GltfLoader, BrokenPngAndJpegAreOneError) {
     for (int bit = 10; bit > 0; --bit) scans.push_back({1, {0, 0, 0, 0}, k, k, bit, bit - 1});
   }
   ASSERT_EQ(scans.size(), 694u);
-  expect_error(image_gltf(libjpeg_encode(smooth_samples(16, 8, 1), 16, 8, 1, false, scans),
+  expect_error(image_gltf(wp::test::jpeg_encode(smooth_samples(16, 8, 1), 16, 8, 1, false, scans),
                           "image/jpeg", "jpeg_scans.gltf"),
                "image 0 'img': cannot decode the JPEG: more than 500 progressive scans");
 }
