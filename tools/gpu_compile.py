@@ -29,6 +29,9 @@ so registers and spills went unchecked.
   tools/gpu_compile.py --scenes scenes/cornell_box.gltf --no-aov --markdown
                                              the table of docs/performance.md
   tools/gpu_compile.py --quick               all features only (no wavepath runs)
+  tools/gpu_compile.py --representative      two of those: all features at width 8 without AOVs,
+                                             and instanced at width 2 with AOVs (each width, BVH
+                                             level and AOV setting once; the default test suite)
 Environment: PTXAS (default: ptxas on PATH, else /usr/local/cuda/bin/ptxas), WP_LIBCLC_DIR
 (default: /usr/lib/clc, Debian's libclc-14), CLANG (default: clang).
 """
@@ -157,6 +160,9 @@ def variants(args, tmp):
                     out[o]["scenes"].append(name)
                 else:
                     out[o] = {"label": label, "options": o, "scenes": [name]}
+    if args.representative:
+        keep = ("all features w8", "all features instances w2 aov")
+        return [v for v in out.values() if v["label"] in keep]
     return list(out.values())
 
 
@@ -254,6 +260,9 @@ def main():
                                  os.path.join(ROOT, "scenes", "failure", "manifest.json")],
                         help="scenes (.gltf/.glb) or failure manifests (.json, with their args)")
     parser.add_argument("--quick", action="store_true", help="all features only")
+    parser.add_argument("--representative", action="store_true",
+                        help="all features at width 8 without AOVs, and instanced at width 2 "
+                             "with them")
     parser.add_argument("--no-aov", action="store_true", help="no WP_AOV=1 variants")
     parser.add_argument("--markdown", action="store_true",
                         help="print the tables as markdown (kernels x variants)")
@@ -269,6 +278,8 @@ def main():
     if missing:
         print(f"gpu_compile: SKIP: {clang} lacks the target(s) {', '.join(missing)}")
         return SKIP
+    if args.representative:
+        args.quick = True
     if not args.quick and not os.access(args.wavepath, os.X_OK):
         fail(f"{args.wavepath} not found (build it, or --quick, or --wavepath PATH)")
     ptxas = find_ptxas()
