@@ -561,22 +561,30 @@ wp::Scene busy_scene() {
 }
 
 // Same seed, same image, bit for bit, whatever the wave size and work-group size; another seed,
-// another image.
-TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
+// another image. Each work-group size, and prefetch or packets off, is a program of its own: the
+// default suite renders one of each change (DeterministicAcrossWaveAndGroupSizes), the slow tier
+// every combination below with both samplers (...Exhaustive).
+struct WaveShapeCase {
+  std::size_t wave, local;
+  bool prefetch, packets;
+};
+
+void expect_deterministic(wp::ClRuntime& runtime, const std::vector<wp::Sampler>& samplers,
+                          const std::vector<WaveShapeCase>& cases) {
   const wp::Scene s = busy_scene();
-  for (wp::Sampler sampler : {wp::Sampler::kSobol, wp::Sampler::kIndependent}) {
+  for (const wp::Sampler sampler : samplers) {
     SCOPED_TRACE(sampler == wp::Sampler::kSobol ? "sobol" : "independent");
     wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
     st.sampler = sampler;
     st.spp = 4;
     st.seed = 11;
-    const wp::Rendered first = wp::render(*runtime_, s, st);
+    const wp::Rendered first = wp::render(runtime, s, st);
     const auto& reference = first.image.rgb;
     // The scene has no instances, alpha or transmission, so on PoCL's CPU devices (the wide BVH)
     // the default traces shadow rays and closest-hit rays in packets: the comparisons below do
     // test both traversals. (Both take turns of packets and single rays per bounce until one is
     // found faster, Wavefront::packet_mode: a render of several waves uses both.)
-    const wp::DeviceEntry& device = runtime_->device();
+    const wp::DeviceEntry& device = runtime.device();
     if (!device.gpu && device.platform_name == "Portable Computing Language") {
       EXPECT_NE(first.report.build_options.find("-D WP_SHADOW_PACKET=1"), std::string::npos)
           << first.report.build_options;
@@ -590,23 +598,12 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
     // each shadow and closest-hit ray traced on its own (on PoCL's CPU devices they go eight to a
     // work-item by default, kernels/traverse8_packet.h, and the wave and group sizes change which
     // rays share a packet).
-    for (const auto& [wave, local, prefetch, packets] :
-         std::vector<std::tuple<std::size_t, std::size_t, bool, bool>>{{0, 0, true, true},
-                                                                       {1000, 0, true, true},
-                                                                       {777, 8, true, true},
-                                                                       {0, 64, true, true},
-                                                                       {256, 32, true, true},
-                                                                       {333, 1, true, true},
-                                                                       {0, 256, true, true},
-                                                                       {0, 0, false, true},
-                                                                       {333, 1, false, true},
-                                                                       {0, 0, true, false},
-                                                                       {777, 8, true, false}}) {
+    for (const auto& [wave, local, prefetch, packets] : cases) {
       st.wave_size = wave;
       st.local_size = local;
       st.prefetch = prefetch;
       st.shadow_packets = st.closest_packets = packets;
-      const wp::Rendered rendered = wp::render(*runtime_, s, st);
+      const wp::Rendered rendered = wp::render(runtime, s, st);
       const auto& image = rendered.image.rgb;
       if (!packets) {
         EXPECT_EQ(rendered.report.closest_packet, 1u);
@@ -634,9 +631,32 @@ TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
     st.local_size = 0;
     st.prefetch = true;
     st.seed = 12;
-    const auto other = wp::render(*runtime_, s, st).image.rgb;
+    const auto other = wp::render(runtime, s, st).image.rgb;
     EXPECT_NE(0, std::memcmp(other.data(), reference.data(), other.size() * sizeof(float)));
   }
+}
+
+TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizes) {
+  expect_deterministic(
+      *runtime_, {wp::Sampler::kSobol},
+      {{1000, 0, true, true}, {777, 8, true, true}, {333, 1, false, true}, {0, 0, true, false}});
+  expect_deterministic(*runtime_, {wp::Sampler::kIndependent},
+                       {{1000, 0, true, true}, {777, 8, true, true}});
+}
+
+TEST_F(RenderKnown, DeterministicAcrossWaveAndGroupSizesExhaustive) {
+  expect_deterministic(*runtime_, {wp::Sampler::kSobol, wp::Sampler::kIndependent},
+                       {{0, 0, true, true},
+                        {1000, 0, true, true},
+                        {777, 8, true, true},
+                        {0, 64, true, true},
+                        {256, 32, true, true},
+                        {333, 1, true, true},
+                        {0, 256, true, true},
+                        {0, 0, false, true},
+                        {333, 1, false, true},
+                        {0, 0, true, false},
+                        {777, 8, true, false}});
 }
 
 // trace_shadow launched ahead of its queue's count (over an estimate from the wave before, then
@@ -687,25 +707,26 @@ TEST_F(RenderKnown, ShadowRaysLaunchedAheadAreEachTracedOnce) {
   }
 }
 
-// In a scene of untextured Lambertian surfaces the fused kernel shades eight paths per work-item
-// on PoCL's CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path
-// kernel's bit for bit, with every kind of light sample (the lamp's triangles and the constant
-// background in SIMD lanes, the point light by the single-path function), each sampler and
-// strategy, and several waves of different sizes (which paths share a packet changes nothing).
-TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
+// The Lambertian busy scene of ShadePacketsGiveTheSinglePathFilm.
+wp::Scene lambert_busy_scene() {
   wp::Scene s = busy_scene();
   s.materials[1] = wp::test::diffuse_material(vec3(0.9f, 0.5f, 0.2f));
   s.materials[2] = wp::test::diffuse_material(vec3(0.3f, 0.8f, 0.6f));
   // Lambert alone: glTF's default specular factor 1 is a dielectric layer (a glossy program).
   for (wp::Material& m : s.materials) m.specular = 0.0f;
-  using wp::Sampler, wp::Strategy;
-  for (const auto& [sampler, strategy, wave] :
-       std::vector<std::tuple<Sampler, Strategy, std::size_t>>{
-           {Sampler::kSobol, Strategy::kMis, 1000},
-           {Sampler::kSobol, Strategy::kNee, 0},
-           {Sampler::kSobol, Strategy::kBsdf, 1000},
-           {Sampler::kSobolPadded, Strategy::kMis, 1000},
-           {Sampler::kIndependent, Strategy::kMis, 0}}) {
+  return s;
+}
+
+struct PacketCase {
+  wp::Sampler sampler;
+  wp::Strategy strategy;
+  std::size_t wave;
+};
+
+// Renders `s` with shade packets and without for each case: the same film bit for bit.
+void expect_packets_match_single_paths(wp::ClRuntime& runtime, const wp::Scene& s,
+                                       const std::vector<PacketCase>& cases) {
+  for (const auto& [sampler, strategy, wave] : cases) {
     SCOPED_TRACE("sampler " + std::to_string(static_cast<int>(sampler)) + ", strategy " +
                  std::to_string(static_cast<int>(strategy)) + ", wave " + std::to_string(wave));
     wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
@@ -713,20 +734,34 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
     st.strategy = strategy;
     st.wave_size = wave;
     st.spp = 4;
-    const wp::Rendered packets = wp::render(*runtime_, s, st);
-    const wp::DeviceEntry& device = runtime_->device();
+    const wp::Rendered packets = wp::render(runtime, s, st);
+    const wp::DeviceEntry& device = runtime.device();
     if (!device.gpu && device.platform_name == "Portable Computing Language") {
       EXPECT_NE(packets.report.build_options.find("-D WP_SHADE_PACKET=1"), std::string::npos)
           << packets.report.build_options;
     }
     st.shade_packets = false;
-    const wp::Rendered single = wp::render(*runtime_, s, st);
+    const wp::Rendered single = wp::render(runtime, s, st);
     EXPECT_EQ(single.report.build_options.find("WP_SHADE_PACKET"), std::string::npos);
     double sum = 0.0;
     for (float v : packets.image.rgb) sum += v;
     EXPECT_GT(sum, 0.0);
     EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ";
   }
+}
+
+// In a scene of untextured Lambertian surfaces the fused kernel shades eight paths per work-item
+// on PoCL's CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path
+// kernel's bit for bit, with every kind of light sample (the lamp's triangles and the constant
+// background in SIMD lanes, the point light by the single-path function), each sampler and
+// strategy, and several waves of different sizes (which paths share a packet changes nothing).
+// The default suite takes two samplers under MIS; ...Exhaustive (slow) each sampler and strategy.
+TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
+  wp::Scene s = lambert_busy_scene();
+  using wp::Sampler, wp::Strategy;
+  expect_packets_match_single_paths(
+      *runtime_, s,
+      {{Sampler::kSobol, Strategy::kMis, 1000}, {Sampler::kIndependent, Strategy::kMis, 0}});
   // Rows not a multiple of eight pixels, so that camera-ray packets span two rows (start_paths8
   // counts pixels on from the first one's), and waves of two samples of the image (a packet across
   // the samples' boundary), of 1000 and of 8 paths: 61 x 37, with a wall behind everything, a
@@ -771,36 +806,59 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
   EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ, many lights";
 }
 
+TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilmExhaustive) {
+  using wp::Sampler, wp::Strategy;
+  expect_packets_match_single_paths(*runtime_, lambert_busy_scene(),
+                                    {{Sampler::kSobol, Strategy::kMis, 1000},
+                                     {Sampler::kSobol, Strategy::kNee, 0},
+                                     {Sampler::kSobol, Strategy::kBsdf, 1000},
+                                     {Sampler::kSobolPadded, Strategy::kMis, 1000},
+                                     {Sampler::kIndependent, Strategy::kMis, 0}});
+}
+
 // The fused shading kernel (kernels/shade.cl) runs the split stages' functions in the same order
 // per path with the same random numbers, so it must give their image bit for bit: with every
 // feature built, AOVs on and off, each sampler, and a thin glass pane (transmission's shadow-ray
-// path) added to the busy scene.
-TEST_F(RenderKnown, FusedAndSplitShadingAreBitIdentical) {
+// path) added to the busy scene. Each case is two programs with every feature: the default suite
+// renders two of them (each sampler once, AOVs once), ...Exhaustive (slow) all four.
+void expect_fused_equals_split(wp::ClRuntime& runtime,
+                               const std::vector<std::pair<wp::Sampler, bool>>& cases) {
   wp::Scene s = busy_scene();
   s.materials.push_back(wp::test::glass_material(false));
   wp::test::add_quad(s, {-1.5f, 0.2f, 1.0f}, {-0.2f, 0.2f, 1.0f}, {-0.2f, 1.6f, 1.0f},
                      {-1.5f, 1.6f, 1.0f}, static_cast<std::uint32_t>(s.materials.size() - 1));
   wp::test::finish_bounds(s);
-  for (wp::Sampler sampler : {wp::Sampler::kSobol, wp::Sampler::kIndependent})
-    for (bool aov : {false, true}) {
-      SCOPED_TRACE(std::string(sampler == wp::Sampler::kSobol ? "sobol" : "independent") +
-                   (aov ? ", aov" : ""));
-      wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
-      st.sampler = sampler;
-      st.aov = aov;
-      st.all_features = true;
-      st.spp = 4;
-      const wp::Rendered fused = wp::render(*runtime_, s, st);
-      st.fused = false;
-      const wp::Rendered split = wp::render(*runtime_, s, st);
-      double sum = 0.0;
-      for (float v : fused.image.rgb) sum += v;
-      EXPECT_GT(sum, 0.0);
-      ASSERT_EQ(fused.image.rgb.size(), split.image.rgb.size());
-      EXPECT_EQ(0, std::memcmp(fused.image.rgb.data(), split.image.rgb.data(),
-                               fused.image.rgb.size() * sizeof(float)));
-      EXPECT_TRUE(fused.film.words() == split.film.words()) << "films differ";
-    }
+  for (const auto& [sampler, aov] : cases) {
+    SCOPED_TRACE(std::string(sampler == wp::Sampler::kSobol ? "sobol" : "independent") +
+                 (aov ? ", aov" : ""));
+    wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
+    st.sampler = sampler;
+    st.aov = aov;
+    st.all_features = true;
+    st.spp = 4;
+    const wp::Rendered fused = wp::render(runtime, s, st);
+    st.fused = false;
+    const wp::Rendered split = wp::render(runtime, s, st);
+    double sum = 0.0;
+    for (float v : fused.image.rgb) sum += v;
+    EXPECT_GT(sum, 0.0);
+    ASSERT_EQ(fused.image.rgb.size(), split.image.rgb.size());
+    EXPECT_EQ(0, std::memcmp(fused.image.rgb.data(), split.image.rgb.data(),
+                             fused.image.rgb.size() * sizeof(float)));
+    EXPECT_TRUE(fused.film.words() == split.film.words()) << "films differ";
+  }
+}
+
+TEST_F(RenderKnown, FusedAndSplitShadingAreBitIdentical) {
+  expect_fused_equals_split(*runtime_,
+                            {{wp::Sampler::kSobol, false}, {wp::Sampler::kIndependent, true}});
+}
+
+TEST_F(RenderKnown, FusedAndSplitShadingAreBitIdenticalExhaustive) {
+  expect_fused_equals_split(*runtime_, {{wp::Sampler::kSobol, false},
+                                        {wp::Sampler::kSobol, true},
+                                        {wp::Sampler::kIndependent, false},
+                                        {wp::Sampler::kIndependent, true}});
 }
 
 }  // namespace
