@@ -12,6 +12,9 @@
 # WebP: twins for fuzz_gltf, payloads for the codecs' targets). The corpus each run grows
 # is kept in build-fuzz/corpus/<target>/, so later runs start where earlier ones stopped.
 #
+# Every run first replays the target's corpus, its seeds and the committed regression inputs
+# (tests/fuzz/regressions/TARGET/), then fuzzes for the rest of its time.
+#
 # Exits non-zero when a target reports a finding (a crash, a sanitizer report, an exception other
 # than wp::Error, a broken scene invariant, a hang over 10 s, a leak, over 2 GiB of memory): the
 # input is saved in build-fuzz/findings/<target>/ and printed with the log's tail. Replay one with
@@ -101,9 +104,12 @@ fuzz() {
   mkdir -p "$corpus" "$findings" "$build/logs"
   echo "wavepath fuzz: $target for ${seconds}s (log: $log)"
   local status=0
-  local dict_arg=()
+  local dict_arg=() regressions=()
   [[ $dict != - ]] && dict_arg=(-dict="tests/fuzz/$dict")
-  "$build/$target" "$corpus" "$build/seeds/$seeds" "${dict_arg[@]}" \
+  # Inputs that once failed the target, committed once fixed (tests/fuzz/regressions/README.md):
+  # read with the seeds before any new input (libFuzzer writes only to the first folder).
+  [[ -d tests/fuzz/regressions/$target ]] && regressions=("tests/fuzz/regressions/$target")
+  "$build/$target" "$corpus" "$build/seeds/$seeds" "${regressions[@]}" "${dict_arg[@]}" \
     -max_len="$max_len" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -detect_leaks=1 -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1 ||
     status=$?

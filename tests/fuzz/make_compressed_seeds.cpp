@@ -150,6 +150,17 @@ int main(int argc, char** argv) {
              "jpeg" + std::to_string(components) + (progressive ? "_progressive" : "") + ".jpg",
              wp::test::jpeg_encode(samples, 24, 16, components, progressive));
       }
+    // An earlier finding's shape: a baseline JPEG whose frame header claims 16000 x 16000 pixels
+    // over a few hundred bytes (a decoder that trusts it allocates 1 GiB before reading the scan).
+    std::vector<unsigned char> big =
+        wp::test::jpeg_encode(std::vector<unsigned char>(24 * 16, 9), 24, 16, 1, false);
+    for (std::size_t i = 0; i + 8 < big.size(); ++i)
+      if (big[i] == 0xff && big[i + 1] == 0xc0) {  // SOF0: length, precision, height, width
+        big[i + 5] = big[i + 7] = 16000 >> 8;
+        big[i + 6] = big[i + 8] = 16000 & 0xff;
+        break;
+      }
+    seed(out / "image", "jpeg_claims_16000.jpg", big);
     if (argc > 2) {
       for (const char* m : {"Box/Box.glb", "BoxTextured/BoxTextured.glb", "Duck/Duck.glb",
                             "DamagedHelmet/DamagedHelmet.glb"}) {

@@ -360,6 +360,10 @@ def builtin_images(out):
         "adam7": png(3, 3, 6, 8, [bytes(4), bytes(4), bytes(8), bytes(4), bytes(4), bytes(12)],
                      interlace=1),
     }
+    # Earlier findings' shape: a header claiming 16000 x 16000 pixels (within the texture limit)
+    # over a few bytes of image data (a decoder that trusts IHDR allocates 1 GB before it finds
+    # the data missing).
+    seeds["claims_16000"] = png(16000, 16000, 6, 8, [bytes(16)] * 4)
     for name, data in seeds.items():
         with open(os.path.join(out, "builtin_%s.png" % name), "wb") as f:
             f.write(data)
