@@ -111,9 +111,12 @@ BuildOptions options(int width, bool splits = false) {
   return o;
 }
 
+// Empty vectors (a layout's unused arrays) may have null data(), which memcmp must not be given
+// even for zero bytes.
 template <class T>
 bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 TEST_F(BvhCache, StoredBvhComesBackIdentical) {
