@@ -29,28 +29,33 @@ void note_allocation(std::size_t n) {
 }
 }  // namespace
 
-void* operator new(std::size_t n) {
+// None of them is inlined: GCC checks that what frees a pointer matches what allocated it
+// (-Wmismatched-new-delete), and an inlined one shows it malloc or free instead. Under the
+// sanitizers (tools/sanitize.sh) it inlined the deletes into gtest's `new TestClass` and warned
+// of operator new's pointer given to free(); with only the deletes out of line, it warned at -O3
+// of malloc's pointer given to operator delete.
+[[gnu::noinline]] void* operator new(std::size_t n) {
   note_allocation(n);
   if (void* p = std::malloc(n ? n : 1)) return p;
   throw std::bad_alloc();
 }
-void* operator new(std::size_t n, std::align_val_t a) {
+[[gnu::noinline]] void* operator new(std::size_t n, std::align_val_t a) {
   note_allocation(n);
   void* p = nullptr;
   const std::size_t align = std::max(static_cast<std::size_t>(a), sizeof(void*));
   if (posix_memalign(&p, align, n ? n : 1) == 0) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept {
+[[gnu::noinline]] void operator delete(void* p) noexcept {
   std::free(p);
 }
-void operator delete(void* p, std::size_t) noexcept {
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
   std::free(p);
 }
-void operator delete(void* p, std::align_val_t) noexcept {
+[[gnu::noinline]] void operator delete(void* p, std::align_val_t) noexcept {
   std::free(p);
 }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+[[gnu::noinline]] void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
   std::free(p);
 }
 
