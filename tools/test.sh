@@ -6,7 +6,9 @@
 #                                          bench, oclgrind, gpu (two representative variants) and
 #                                          fuzz (WP_FUZZ_SECONDS per target, default 10; 0 skips
 #                                          them), without the tests also labelled slow
-#   tools/test.sh --quick [CTEST_ARGS...]  the developer loop: no fuzz, oclgrind, gpu or bench
+#   tools/test.sh --quick [CTEST_ARGS...]  the developer loop: the unit, kernel and sampling tiers
+#                                          (host code, every kernel against its host reference,
+#                                          every sampling routine's chi-square test), not slow
 #   tools/test.sh --all [CTEST_ARGS...]    everything: the default suite and the slow tier (the
 #                                          accuracy_* scenes, every GPU variant); what CI runs
 # Extra arguments go to ctest, e.g. tools/test.sh -R bvh, tools/test.sh -L kernel. WP_TEST_JOBS
@@ -33,7 +35,7 @@ export POCL_WORK_GROUP_SPECIALIZATION=${POCL_WORK_GROUP_SPECIALIZATION:-0}
 jobs=${WP_TEST_JOBS:-$(($(nproc 2>/dev/null || echo 2) + 1))}
 args=(--output-on-failure --timeout 600 -j"$jobs")
 if [[ $tier == quick ]]; then
-  args+=(-LE 'fuzz|oclgrind|gpu|bench|slow')
+  args+=(-L 'unit|kernel|sampling' -LE slow)
 else
   [[ $tier == default ]] && args+=(-LE slow)
   fuzz_seconds=${WP_FUZZ_SECONDS:-10}
