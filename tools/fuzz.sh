@@ -7,10 +7,11 @@
 #                     (tests/fuzz/fuzz_compressed.cpp)
 #   fuzz_image        wp::decode_image on PNG, JPEG and WebP bytes (libpng, libjpeg-turbo, libwebp)
 # Seeds: tests/fuzz/make_seeds.py's built-in ones, plus small models and cropped .hdr maps from
-# ../shared/assets (WAVEPATH_ASSETS overrides) when that folder exists; for the compressed data,
-# build-fuzz/make_compressed_seeds compresses a built-in quad and those models (Draco, meshopt,
-# WebP: twins for fuzz_gltf, payloads for the codecs' targets). The corpus each run grows
-# is kept in build-fuzz/corpus/<target>/, so later runs start where earlier ones stopped.
+# ../shared/assets (WAVEPATH_ASSETS overrides) when that folder exists; for the compressed data and
+# JPEGs, the main build's build/tests/make_compressed_seeds compresses a built-in quad and those
+# models (Draco, meshopt, WebP: twins for fuzz_gltf, payloads for the codecs' targets). The corpus
+# each run grows is kept in build-fuzz/corpus/<target>/, so later runs start where earlier ones
+# stopped.
 #
 # Every run first replays the target's corpus, its seeds and the committed regression inputs
 # (tests/fuzz/regressions/TARGET/), then fuzzes for the rest of its time.
@@ -81,7 +82,13 @@ if ((build_step)); then
   cmake --build "$build" -j"$jobs" >/dev/null
   rm -rf "$build/seeds"
   python3 tests/fuzz/make_seeds.py "$build/seeds" "$assets"
-  "$build/make_compressed_seeds" "$build/seeds" "$assets"
+  # The compressed and JPEG seeds, by a tool of the main build (build/, tools/setup.sh).
+  if [[ ! -d build ]]; then
+    echo "wavepath fuzz: build/ missing (tools/setup.sh builds it; the seed maker is there)" >&2
+    exit 1
+  fi
+  cmake --build build -j"$jobs" --target make_compressed_seeds >/dev/null
+  build/tests/make_compressed_seeds "$build/seeds" "$assets"
 fi
 ((run_step)) || exit 0
 for t in "${targets[@]}"; do
