@@ -109,13 +109,11 @@
 #define WP_SAMPLER WP_SAMPLER_SOBOL
 #endif
 
-/* Sampling strategy for direct light: full MIS of NEE and BSDF sampling, NEE only, BSDF only. */
+/* Sampling strategy for direct light (Launch.strategy, not a build option): full MIS of NEE and
+ * BSDF sampling, NEE only, BSDF only. */
 #define WP_STRATEGY_MIS 0
 #define WP_STRATEGY_NEE 1
 #define WP_STRATEGY_BSDF 2
-#ifndef WP_STRATEGY
-#define WP_STRATEGY WP_STRATEGY_MIS
-#endif
 /* MIS heuristic: 1 power (beta = 2), 0 balance. */
 #ifndef WP_MIS_POWER
 #define WP_MIS_POWER 1

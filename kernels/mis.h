@@ -5,7 +5,8 @@
  * p / (p + q) or the power heuristic p^2 / (p^2 + q^2). A delta light or a delta lobe can only be
  * found by one strategy: its weight is 1 (callers pass q = 0).
  *
- * WP_STRATEGY selects what is counted: MIS (both, weighted), NEE (light samples with weight 1;
+ * The strategy (WP_STRATEGY_*, Launch.strategy) selects what is counted: MIS (both, weighted),
+ * NEE (light samples with weight 1;
  * emission found by BSDF sampling only where NEE cannot reach it: after a delta lobe or from the
  * camera) or BSDF (no NEE; all emission found by BSDF sampling, weight 1; punctual lights then
  * contribute nothing, which is the expected answer for that strategy). */
@@ -30,36 +31,22 @@ static inline float mis_weight(float p_own, float p_other) {
 
 /* Weight of emission that a BSDF-sampled ray found, given the pdf of that sample (0 after a
  * delta lobe or for a camera ray) and the pdf with which NEE would have produced it. */
-static inline float mis_weight_bsdf_hit(float p_bsdf, float p_light) {
-#if WP_STRATEGY == WP_STRATEGY_MIS
-  return p_bsdf > 0.0f ? mis_weight(p_bsdf, p_light) : 1.0f;
-#elif WP_STRATEGY == WP_STRATEGY_NEE
-  (void)p_light;
-  return p_bsdf > 0.0f ? 0.0f : 1.0f;
-#else
-  (void)p_bsdf;
-  (void)p_light;
-  return 1.0f;
-#endif
+static inline float mis_weight_bsdf_hit(float p_bsdf, float p_light, uint strategy) {
+  if (strategy == WP_STRATEGY_BSDF || !(p_bsdf > 0.0f)) return 1.0f;
+  return strategy == WP_STRATEGY_MIS ? mis_weight(p_bsdf, p_light) : 0.0f;
 }
 
 /* Weight of a light sample with pdf p_light (0 < p_light; `delta` for a delta light) against the
- * BSDF's pdf p_bsdf of the same direction. */
-static inline float mis_weight_light(float p_light, float p_bsdf, bool delta) {
-#if WP_STRATEGY == WP_STRATEGY_MIS
-  return delta ? 1.0f : mis_weight(p_light, p_bsdf);
-#else
-  (void)p_light;
-  (void)p_bsdf;
-  (void)delta;
-  return 1.0f;
-#endif
+ * BSDF's pdf p_bsdf of the same direction (only MIS weighs; NEE counts it whole, BSDF takes
+ * none). */
+static inline float mis_weight_light(float p_light, float p_bsdf, bool delta, uint strategy) {
+  return strategy == WP_STRATEGY_MIS && !delta ? mis_weight(p_light, p_bsdf) : 1.0f;
 }
 
 #if WP_SHADE_PACKET
 /* mis_weight_light of eight lanes (common.h) for lights that are not delta lights. */
-WP_LANES_FN float8 mis_weight_light8(float8 p_light, float8 p_bsdf) {
-#if WP_STRATEGY == WP_STRATEGY_MIS
+WP_LANES_FN float8 mis_weight_light8(float8 p_light, float8 p_bsdf, uint strategy) {
+  if (strategy != WP_STRATEGY_MIS) return (float8)(1.0f);
   const float8 r = p_bsdf / p_light;
 #if WP_MIS_POWER
   const float8 w = 1.0f / (1.0f + r * r);
@@ -68,10 +55,6 @@ WP_LANES_FN float8 mis_weight_light8(float8 p_light, float8 p_bsdf) {
 #endif
   const float8 inf_own = select((float8)(1.0f), (float8)(0.5f), isinf(p_bsdf));
   return select(select(w, inf_own, isinf(p_light)), (float8)(1.0f), !(p_bsdf > 0.0f));
-#else
-  (void)p_light, (void)p_bsdf;
-  return (float8)(1.0f);
-#endif
 }
 #endif
 

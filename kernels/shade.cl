@@ -40,17 +40,12 @@ WP_GROUP_KERNEL void shade(WP_STAGE_PARAMS) {
     if (shade_hit(&scene, paths, launch, slot, &s)) {
       /* What the BSDF needs of the incoming direction, once for both samples. */
       const BsdfView v = bsdf_view(&s, -path_ray_dir(paths, slot));
-#if WP_STRATEGY != WP_STRATEGY_BSDF
-      shadow = sample_light_ray(&scene, paths, queues, slot, &s, &v, t, &u);
-#endif
+      if (launch.strategy != WP_STRATEGY_BSDF)
+        shadow = sample_light_ray(&scene, paths, queues, slot, &s, &v, t, &u, launch.strategy);
       sample_next_ray(paths, queues, slot, &s, &v, t, &u);
       survives = roulette(paths, queues, launch, slot, u.roulette);
     }
   }
-#if WP_STRATEGY != WP_STRATEGY_BSDF
   queue_push_group2(queues, WP_QUEUE_SHADOW, shadow, launch.queue_out, survives, slot, scan);
-#else
-  queue_push_group(queues, launch.queue_out, survives, slot, scan);
-#endif
 #endif
 }

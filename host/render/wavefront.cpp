@@ -38,7 +38,6 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
   o += " -D WP_GROUP_SIZE=" + std::to_string(group_size);
   if (prefetch) o += " -D WP_PREFETCH=1";
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
-  o += " -D WP_STRATEGY=" + std::to_string(static_cast<int>(s.strategy));
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
   // kernels/features.h's WP_SAMPLER_INDEPENDENT, _SOBOL and _SOBOL_PADDED.
   o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kIndependent ? "0"
@@ -408,6 +407,7 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   p.max_depth = static_cast<dev::uint>(settings_.max_depth);
   p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
   p.rr_threshold = settings_.rr_threshold;
+  p.strategy = static_cast<dev::uint>(settings_.strategy);  // WP_STRATEGY_* (kernels/features.h)
   // Packets where the program has them; run_wave picks per bounce.
   p.packet = closest_packet_;
   p.shadow_packet = shadow_packet_;

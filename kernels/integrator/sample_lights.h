@@ -1,7 +1,7 @@
 /* Next-event estimation for one path: one light point sampled (lights.h), the BSDF evaluated
  * toward it, and a shadow ray that adds throughput * f * |cos| * L / pdf * w_light (mis.h) if
- * nothing occludes it. Nothing on surfaces with delta lobes alone, nor with WP_STRATEGY_BSDF. Used
- * by sample_lights.cl and the fused shade.cl. */
+ * nothing occludes it. Nothing on surfaces with delta lobes alone; not called under
+ * WP_STRATEGY_BSDF (Launch.strategy). Used by sample_lights.cl and the fused shade.cl. */
 #ifndef WP_INTEGRATOR_SAMPLE_LIGHTS_H
 #define WP_INTEGRATOR_SAMPLE_LIGHTS_H
 
@@ -10,20 +10,20 @@
 #include "mis.h"
 #include "surface.h"
 
-#if WP_STRATEGY != WP_STRATEGY_BSDF
 /* NEE at surface s, seen as v (bsdf_view at -ray_d), hit at distance t, of the path in `slot`
- * with the bounce's random numbers u (its light pick and light point): a shadow ray for
- * WP_QUEUE_SHADOW, true when there is one (the caller pushes it). The fused pipeline's shadow ray
- * takes the hit record's place, so t comes from the caller, which read it before. */
+ * with the bounce's random numbers u (its light pick and light point), weighed for `strategy`
+ * (MIS or NEE): a shadow ray for WP_QUEUE_SHADOW, true when there is one (the caller pushes it).
+ * The fused pipeline's shadow ray takes the hit record's place, so t comes from the caller, which
+ * read it before. */
 WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues queues, uint slot,
                                   const Surface* s, const BsdfView* v, float t,
-                                  const BounceRandom* u) {
+                                  const BounceRandom* u, uint strategy) {
   if (scene->desc->light_count == 0 || bsdf_only_delta(s)) return false;
   const LightSample ls = sample_light(scene, s->p, u->light_pick, u->light_uv);
   if (!(ls.pdf > 0.0f)) return false;
   const float3 ray_d = path_ray_dir(paths, slot);
   const BsdfEval e = bsdf_eval_view(s, v, -ray_d, ls.wi);
-  const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta);
+  const float w = mis_weight_light(ls.pdf, e.pdf, ls.delta, strategy);
   const float3 c =
       path_throughput(paths, slot) * e.f * ls.li * (fabs(dot(s->ns, ls.wi)) * w / ls.pdf);
   if (!all(isfinite(c))) {
@@ -52,12 +52,13 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
 /* sample_light_ray of eight lanes (common.h, shade_packet.h) for the paths in slots[i] whose bit
  * is set in `lanes`: their light is emissive triangle tri[i], or the constant background where
  * bit i of `env` is set, picked with probability pmf, the point at (ux, uy); surface s seen at
- * cosine cos_o, hit at distance t along ray_d, throughput beta. Returns the lanes with a shadow
- * ray. */
+ * cosine cos_o, hit at distance t along ray_d, throughput beta; weighed for `strategy`. Returns
+ * the lanes with a shadow ray. */
 WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues queues,
                                    const uint* slots, uint lanes, uint env, const Surface8* s,
                                    float8 cos_o, Float3x8 ray_d, float8 t, Float3x8 beta,
-                                   const uint* tri, float8 pmf, float8 ux, float8 uy) {
+                                   const uint* tri, float8 pmf, float8 ux, float8 uy,
+                                   uint strategy) {
   LightSample8 ls = sample_triangle8(scene, tri, s->p, ux, uy);
   const int8 sky = ((int8)(1, 2, 4, 8, 16, 32, 64, 128) & (int8)(env)) != 0;
   if (env != 0u) { /* env_sample without a map */
@@ -70,7 +71,7 @@ WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues q
   ls.pdf *= pmf;
   float8 e_pdf;
   const Float3x8 f = bsdf_eval8(s, cos_o, ls.wi, &e_pdf);
-  const float8 w = mis_weight_light8(ls.pdf, e_pdf);
+  const float8 w = mis_weight_light8(ls.pdf, e_pdf, strategy);
   const float8 k = fabs(dot3x8(s->ns, ls.wi)) * w / ls.pdf;
   const Float3x8 c = {beta.x * f.x * ls.li.x * k, beta.y * f.y * ls.li.y * k,
                       beta.z * f.z * ls.li.z * k};
@@ -97,7 +98,6 @@ WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues q
   }
   return rays;
 }
-#endif
 #endif
 
 #endif /* WP_INTEGRATOR_SAMPLE_LIGHTS_H */

@@ -114,15 +114,14 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
     if (!((hits >> i) & 1u) || !(max3(scene->materials[tv[i].w].emission.xyz) > 0.0f)) continue;
     add_hit_emission(scene, paths, slots[i], WP_NO_INSTANCE, tri[i], tv[i], lane_of(t, i),
                      lane3(beta, i), lane_of(bsdf_pdf, i), lane3(ray_d, i), lane_set(s.front, i),
-                     lane3(s.ng, i));
+                     lane3(s.ng, i), launch.strategy);
   }
 #endif
   /* The paths that scatter: fewer than max_depth events so far. */
   const uint go = hits & (uint)lane_bits8(bounce < (uint8)(launch.max_depth));
   if (go == 0u) return;
   const float8 cos_o = dot3x8(s.ns, neg3x8(ray_d)); /* bsdf_view */
-#if WP_STRATEGY != WP_STRATEGY_BSDF
-  if (scene->desc->light_count != 0u) {
+  if (launch.strategy != WP_STRATEGY_BSDF && scene->desc->light_count != 0u) {
     /* The light each path picks (sample_light): a triangle's point in the lanes, any other light
      * by sample_light_ray itself. */
     uint ltri[WP_SHADE_LANES], picked[WP_SHADE_LANES], lanes = 0u, env = 0u;
@@ -151,15 +150,15 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
         BounceRandom one_u; /* what sample_light_ray reads of it */
         one_u.light_pick = lane_of(light_pick, i);
         one_u.light_uv = (float2)(lane_of(light_u, i), lane_of(light_v, i));
-        if (sample_light_ray(scene, paths, queues, slots[i], &one, &v, lane_of(t, i), &one_u))
+        if (sample_light_ray(scene, paths, queues, slots[i], &one, &v, lane_of(t, i), &one_u,
+                             launch.strategy))
           *shadow |= 1u << i;
       }
     }
     if (lanes != 0u)
       *shadow |= sample_light_ray8(scene, paths, queues, slots, lanes, env, &s, cos_o, ray_d, t,
-                                   beta, ltri, pmf, lu, light_v);
+                                   beta, ltri, pmf, lu, light_v, launch.strategy);
   }
-#endif
   *survives = sample_next_ray8(paths, queues, launch, slots, go, &s, cos_o, ray_d, t, beta, bounce,
                                bsdf_u, bsdf_v, roulette_u);
 }

@@ -43,7 +43,7 @@ static inline void aov_record(Paths paths, uint slot, float3 albedo, float3 norm
  * shade_packet.h. */
 static inline void add_hit_emission(const SceneView* scene, Paths paths, uint slot, uint inst,
                                     uint tri, uint4 tv, float t, float3 beta, float bsdf_pdf,
-                                    float3 ray_d, bool front, float3 ng) {
+                                    float3 ray_d, bool front, float3 ng, uint strategy) {
   if (!front && !(scene->materials[tv.w].flags.x & WP_MAT_DOUBLE_SIDED)) return;
   const float3 le = material_emission(scene, tv, path_hit_u(paths, slot), path_hit_v(paths, slot));
   if (!(max3(le) > 0.0f)) return;
@@ -51,7 +51,8 @@ static inline void add_hit_emission(const SceneView* scene, Paths paths, uint sl
   const float dist = t + path_pane_distance(paths, slot);
   const float p_light = triangle_light_pdf(scene, inst, tri, dist, dot(ng, ray_d));
   path_set_radiance(
-      paths, slot, path_radiance(paths, slot) + beta * le * mis_weight_bsdf_hit(bsdf_pdf, p_light));
+      paths, slot,
+      path_radiance(paths, slot) + beta * le * mis_weight_bsdf_hit(bsdf_pdf, p_light, strategy));
 }
 #endif
 
@@ -69,8 +70,8 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
      * lobe (bsdf_pdf 0), whose weight is 1 whatever it is. */
     float light_pdf;
     const float3 le = environment_hit(
-        scene, ray_d, WP_STRATEGY == WP_STRATEGY_MIS && bsdf_pdf > 0.0f, &light_pdf);
-    const float w = mis_weight_bsdf_hit(bsdf_pdf, light_pdf);
+        scene, ray_d, launch.strategy == WP_STRATEGY_MIS && bsdf_pdf > 0.0f, &light_pdf);
+    const float w = mis_weight_bsdf_hit(bsdf_pdf, light_pdf, launch.strategy);
     path_set_radiance(paths, slot, path_radiance(paths, slot) + beta * le * w);
 #if WP_AOV
     aov_record(paths, slot, clamp(le, 0.0f, 1.0f), (float3)(0.0f));
@@ -112,7 +113,8 @@ WP_STAGE_FN bool shade_hit(const SceneView* scene, Paths paths, Launch launch, u
   }
 #endif
 #if WP_FEATURE_EMISSION
-  add_hit_emission(scene, paths, slot, inst, tri, tv, t, beta, bsdf_pdf, ray_d, front, s->ng);
+  add_hit_emission(scene, paths, slot, inst, tri, tv, t, beta, bsdf_pdf, ray_d, front, s->ng,
+                   launch.strategy);
 #endif
 #if WP_FEATURE_UNLIT
   if (s->flags & WP_SURF_UNLIT) { /* shows its colour as emitted radiance; nothing scatters */

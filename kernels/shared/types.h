@@ -210,7 +210,8 @@ typedef struct Launch {
   uint shadow_packet; /* trace_shadow's: 1, or WP_PACKET where the program has WP_SHADOW_PACKET */
   uint shadow_first;  /* trace_shadow's first queue entry: 0, or where an earlier launch of the
                          bounce stopped (Wavefront::run_bounce) */
-  uint pad;           /* to 64 bytes, a multiple of 16 on every device */
+  uint strategy;      /* WP_STRATEGY_*: the direct light counted (mis.h), a launch parameter so
+                         that one program renders every strategy */
 } Launch;
 
 WP_DEV_END

@@ -54,7 +54,7 @@ inline AlbedoSample albedo_sample(const Surface* s, float3 wo, float3 t, float3 
   if (bs.valid) {
     a.bad |= !finite3(bs.weight) || !isfinite(bs.pdf);
     a.bsdf_only = bs.weight;
-    a.mis = bs.weight * mis_weight_bsdf_hit(bs.pdf, p_light); /* pdf 0 (delta): weight 1 */
+    a.mis = bs.weight * mis_weight_bsdf_hit(bs.pdf, p_light, WP_STRATEGY_MIS); /* delta: 1 */
   }
   /* The light sample: a uniform direction on the sphere; none where light sampling does not run
    * (bsdf_only_delta, as integrator/sample_lights.h). */
