@@ -342,6 +342,8 @@ Film accumulate_on_device(
   wp::RenderSettings settings;
   settings.width = width;
   settings.height = height;
+  // One path a pixel, whatever the machine's cache or WAVEPATH_WAVE_SIZE would choose.
+  settings.wave_size = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   std::vector<std::uint32_t> flags;
   wp::bvh::BuildOptions options;
   options.width = wp::bvh_width(runtime.device(), settings);

@@ -317,6 +317,7 @@ class IntersectKernel : public ::testing::Test {
     wp::RenderSettings s;
     s.width = static_cast<int>(kWave);
     s.height = 1;
+    s.wave_size = kWave;  // one ray a path: never a smaller wave from the machine's cache
     return s;
   }
   static std::vector<wp::dev::uint> identity(std::size_t n) {
