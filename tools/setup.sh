@@ -3,6 +3,10 @@
 # configures and builds a Release build in build/. Used by tools/run.sh and tools/test.sh.
 #
 #   tools/setup.sh             the build
+#   tools/setup.sh --tests     also the fuzz targets (tools/fuzz.sh --build: build-fuzz/, clang++
+#                              with libFuzzer and the sanitizers) when clang++ can build them and
+#                              WP_FUZZ_SECONDS is not 0; tools/test.sh builds with this, so that
+#                              the suite's time is the tests' own
 #   tools/setup.sh --denoise   also Intel Open Image Denoise for `wavepath render --denoise`: not
 #                              in Debian 12, so PyPI's pyoidn wheel (which ships the library with
 #                              the TBB it needs) is pip-installed into the venv build/oidn-venv,
@@ -13,11 +17,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-denoise=0
+denoise=0 tests=0
 for arg in "$@"; do
   case $arg in
     --denoise) denoise=1 ;;
-    *) echo "usage: tools/setup.sh [--denoise]" >&2; exit 2 ;;
+    --tests) tests=1 ;;
+    *) echo "usage: tools/setup.sh [--denoise] [--tests]" >&2; exit 2 ;;
   esac
 done
 
@@ -56,6 +61,10 @@ fi
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
+if ((tests)) && [[ ${WP_FUZZ_SECONDS:-5} != 0 ]] && tools/fuzz.sh --check; then
+  echo "wavepath: building the fuzz targets (build-fuzz/)" >&2
+  tools/fuzz.sh --build
+fi
 
 if ((denoise)); then
   # The version the figures of docs/denoise.md were measured with. --no-deps: only the library is

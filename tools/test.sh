@@ -29,7 +29,7 @@ tier=default
 case ${1:-} in
   --quick | --all) tier=${1#--} && shift ;;
 esac
-tools/setup.sh
+tools/setup.sh --tests
 
 export POCL_WORK_GROUP_SPECIALIZATION=${POCL_WORK_GROUP_SPECIALIZATION:-0}
 jobs=${WP_TEST_JOBS:-$(($(nproc 2>/dev/null || echo 2) + 1))}
