@@ -29,9 +29,11 @@ so registers and spills went unchecked.
   tools/gpu_compile.py --scenes scenes/cornell_box.gltf --no-aov --markdown
                                              the table of docs/performance.md
   tools/gpu_compile.py --quick               all features only (no wavepath runs)
-  tools/gpu_compile.py --representative      two of those: all features at width 8 without AOVs,
-                                             and instanced at width 2 with AOVs (each width, BVH
-                                             level and AOV setting once; the default test suite)
+  tools/gpu_compile.py --representative      two of those, each for one target: all features at
+                                             width 8 without AOVs for amdgcn, instanced at width 2
+                                             with AOVs (a GPU's layout) for nvptx64 and ptxas (each
+                                             width, BVH level, AOV setting and target once; the
+                                             default test suite)
 Environment: PTXAS (default: ptxas on PATH, else /usr/local/cuda/bin/ptxas), WP_LIBCLC_DIR
 (default: /usr/lib/clc, Debian's libclc-14), CLANG (default: clang).
 """
@@ -160,9 +162,13 @@ def variants(args, tmp):
                     out[o]["scenes"].append(name)
                 else:
                     out[o] = {"label": label, "options": o, "scenes": [name]}
+    for v in out.values():
+        v["targets"] = list(TARGETS)
     if args.representative:
-        keep = ("all features w8", "all features instances w2 aov")
-        return [v for v in out.values() if v["label"] in keep]
+        keep = {"all features w8": ["amdgcn"], "all features instances w2 aov": ["nvptx64"]}
+        for v in out.values():
+            v["targets"] = keep.get(v["label"], [])
+        return [v for v in out.values() if v["targets"]]
     return list(out.values())
 
 
@@ -293,7 +299,7 @@ def main():
         jobs = []
         with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
             for i, v in enumerate(found):
-                for target in TARGETS:
+                for target in v["targets"]:
                     jobs.append((v, target, pool.submit(compile_variant, clang, target, v,
                                                         program, tmp, i)))
         errors = 0
@@ -308,14 +314,14 @@ def main():
                 ptx[v["options"]] = out
             else:
                 amd[v["options"]] = amd_report(readelf, out)
-        print(f"gpu_compile: {len(found)} variants x {len(TARGETS)} targets, {errors} failed "
+        print(f"gpu_compile: {len(jobs)} compiles of {len(found)} variants, {errors} failed "
               f"(clang -Wall -Wextra -Werror; nvptx64 sm_86, amdgcn gfx90a; libclc "
               f"{'linked' if nv_lib else 'absent'})")
         for v in found:
             print(f"  {v['label']:<40} {', '.join(v['scenes'])}")
         if errors:
             return 1
-        if not ptxas or not nv_lib:
+        if ptx and (not ptxas or not nv_lib):
             why = "ptxas not found (PTXAS=...)" if not ptxas else \
                 "libclc's nvptx64--nvidiacl.bc not found (apt-get install libclc-14)"
             print(f"gpu_compile: SKIP: the clang part passed; {why}, so no registers or spills")
@@ -323,17 +329,18 @@ def main():
 
         results, spills = [], []
         with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
-            reports = [(v, pool.submit(ptxas_report, ptxas, ptx[v["options"]])) for v in found]
+            reports = [(v, pool.submit(ptxas_report, ptxas, ptx[v["options"]])
+                        if v["options"] in ptx else None) for v in found]
         for v, job in reports:
-            kernels, stderr = job.result()
-            if kernels is None or set(kernels) != set(STAGES):
+            kernels, stderr = job.result() if job else ({}, "")
+            if job and (kernels is None or set(kernels) != set(STAGES)):
                 print(f"FAIL ptxas [{v['label']}]\n{stderr}", file=sys.stderr)
                 return 1
-            results.append({"variant": v, "ptxas": kernels, "amd": amd[v["options"]]})
+            a = amd.get(v["options"])
+            results.append({"variant": v, "ptxas": kernels, "amd": a})
             spills += [(v["label"], "sm_90", k) for k in TRAVERSAL
-                       if kernels[k]["spill_stores"] or kernels[k]["spill_loads"]]
-            spills += [(v["label"], "gfx90a", k) for k in TRAVERSAL
-                       if amd[v["options"]] and amd[v["options"]][k]["vgpr_spills"]]
+                       if kernels and (kernels[k]["spill_stores"] or kernels[k]["spill_loads"])]
+            spills += [(v["label"], "gfx90a", k) for k in TRAVERSAL if a and a[k]["vgpr_spills"]]
         if args.markdown:
             markdown(results)
         else:
@@ -343,7 +350,8 @@ def main():
                   f"{'scratch':>8}")
             for r in results:
                 for k in STAGES:
-                    p = r["ptxas"][k]
+                    p = r["ptxas"][k] if r["ptxas"] else dict.fromkeys(
+                        ["regs", "spill_stores", "spill_loads", "stack"], "-")
                     a = r["amd"][k] if r["amd"] else dict.fromkeys(
                         ["vgprs", "sgprs", "vgpr_spills", "sgpr_spills", "scratch"], "-")
                     print(f"{r['variant']['label']:<40} {k:<21} {p['regs']:>5} "
