@@ -907,9 +907,11 @@ TEST(Sampling, CosineHemisphere) {
 // reflections included), so it integrates to 1 at every view angle. Its support ends where the
 // microfacet normal reaches the horizon, z = -v.z, a jump in the pdf: the view angles have
 // v.z = k/16, so that circle is a bin edge (acos(1/16) = 86.4 degrees: grazing).
-TEST(Sampling, GgxVisibleNormalReflection) {
-  for (float alpha : {0.05f, 0.1f, 0.3f, 0.6f, 1.0f})
-    for (int k : {16, 12, 8, 4, 1}) {
+// The default suite checks three roughnesses at three angles (normal, 60 degrees, grazing),
+// ...Exhaustive (slow) five at five.
+void check_ggx_visible_normals(std::initializer_list<float> alphas, std::initializer_list<int> ks) {
+  for (float alpha : alphas)
+    for (int k : ks) {
       char name[64];
       std::snprintf(name, sizeof name, "ggx alpha %.2f v.z %d/16", alpha, k);
       Config c{name, kGgx, kPoleOnNormal};
@@ -918,6 +920,13 @@ TEST(Sampling, GgxVisibleNormalReflection) {
       c.all_valid = true;
       check_config(c);
     }
+}
+
+TEST(Sampling, GgxVisibleNormalReflection) {
+  check_ggx_visible_normals({0.05f, 0.3f, 1.0f}, {16, 8, 1});
+}
+TEST(Sampling, GgxVisibleNormalReflectionExhaustive) {
+  check_ggx_visible_normals({0.05f, 0.1f, 0.3f, 0.6f, 1.0f}, {16, 12, 8, 4, 1});
 }
 
 // glTF's metallic-roughness BRDF: the default suite checks two roughnesses at normal and grazing
@@ -938,33 +947,52 @@ TEST(Sampling, GltfBrdfExhaustive) {
 }
 
 // Roughness 0: the specular layer is a delta lobe; bsdf_eval's pdf is then the diffuse part
-// alone, and metallic 1 leaves nothing but the delta lobe.
-TEST(Sampling, GltfBrdfSmoothSpecular) {
+// alone, and metallic 1 leaves nothing but the delta lobe. The default suite takes the saturated
+// colour at 45 and 80 degrees, ...Exhaustive (slow) both colours at three angles.
+void check_smooth_specular(std::initializer_list<float4> colors,
+                           std::initializer_list<double> views) {
   for (float metallic : {0.0f, 0.5f, 1.0f})
-    for (float4 color : {kWhite, kSaturated})
-      for (double view : {0.0, 45.0, 80.0}) check_bsdf(bsdf_config(metallic, 0.0f, color, view));
+    for (float4 color : colors)
+      for (double view : views) check_bsdf(bsdf_config(metallic, 0.0f, color, view));
+}
+TEST(Sampling, GltfBrdfSmoothSpecular) {
+  check_smooth_specular({kSaturated}, {45.0, 80.0});
+}
+TEST(Sampling, GltfBrdfSmoothSpecularExhaustive) {
+  check_smooth_specular({kWhite, kSaturated}, {0.0, 45.0, 80.0});
 }
 
 // The Lambert-only build (a scene without specular layers): the cosine lobe at every roughness,
-// smooth included (no delta lobe), and f cos / pdf = base colour (the weight check).
-TEST(Sampling, LambertOnlyBuild) {
-  for (float roughness : {0.0f, 0.5f, 1.0f})
-    for (float4 color : {kWhite, kSaturated})
-      for (double view : {0.0, 45.0, 80.0}) {
+// smooth included (no delta lobe), and f cos / pdf = base colour (the weight check). The default
+// suite takes roughness 0 and 1 in the saturated colour at normal and grazing view,
+// ...Exhaustive (slow) three roughnesses, both colours, three angles.
+void check_lambert_only(std::initializer_list<float> roughnesses,
+                        std::initializer_list<float4> colors, std::initializer_list<double> views) {
+  for (float roughness : roughnesses)
+    for (float4 color : colors)
+      for (double view : views) {
         Config c = bsdf_config(0.0f, roughness, color, view);
         c.name += " lambert-only build";
         c.lambert_build = true;
         check_bsdf(c);
       }
 }
+TEST(Sampling, LambertOnlyBuild) {
+  check_lambert_only({0.0f, 1.0f}, {kSaturated}, {0.0, 80.0});
+}
+TEST(Sampling, LambertOnlyBuildExhaustive) {
+  check_lambert_only({0.0f, 0.5f, 1.0f}, {kWhite, kSaturated}, {0.0, 45.0, 80.0});
+}
 
 // Dielectric transmission (KHR_materials_transmission, ior 1.5), thin-walled and with a volume
 // (KHR_materials_volume). "Inside" is what bsdf.h's Surface says: the normals always face wo, and
 // WP_SURF_FRONT is clear on a WP_SURF_VOLUME surface when the ray arrived on the back side, from
 // inside (relative ior 1 / 1.5; total internal reflection from 41.8 degrees on). Add a
-// configuration by adding a line.
-TEST(Sampling, DielectricTransmission) {
-  const std::vector<Config> configs = {
+// configuration by adding a line. The default suite takes each regime (thin-walled, entering,
+// leaving, beyond the critical angle, every lobe) at two of its roughnesses or angles,
+// ...Exhaustive (slow) every line.
+std::vector<Config> dielectric_configs() {
+  return {
       bsdf_config(0, 0.0f, kWhite, 30, 1, kFront),  // thin-walled
       bsdf_config(0, 0.3f, kWhite, 30, 1, kFront),
       bsdf_config(0, 0.7f, kWhite, 30, 1, kFront),
@@ -982,7 +1010,13 @@ TEST(Sampling, DielectricTransmission) {
       bsdf_config(0.5f, 0.3f, kSaturated, 30, 0.5f, kVolume | kFront),  // every lobe at once
       bsdf_config(0, 0.0f, kSaturated, 45, 0.5f, kFront),
   };
-  for (const Config& c : configs) check_bsdf(c);
+}
+TEST(Sampling, DielectricTransmission) {
+  const std::vector<Config> configs = dielectric_configs();
+  for (const std::size_t i : {0, 3, 4, 7, 9, 10, 11, 13, 14, 15}) check_bsdf(configs[i]);
+}
+TEST(Sampling, DielectricTransmissionExhaustive) {
+  for (const Config& c : dielectric_configs()) check_bsdf(c);
 }
 
 // The layered material extensions (kernels/bsdf.h): every configuration is the whole BSDF, its
