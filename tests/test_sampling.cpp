@@ -930,20 +930,20 @@ TEST(Sampling, GgxVisibleNormalReflectionExhaustive) {
 }
 
 // glTF's metallic-roughness BRDF: the default suite checks two roughnesses at normal and grazing
-// view, ...Exhaustive (slow) four at three angles.
-void check_gltf_brdf(std::initializer_list<float> roughnesses,
+// view in the saturated colour, ...Exhaustive (slow) four at three angles in both colours.
+void check_gltf_brdf(std::initializer_list<float> roughnesses, std::initializer_list<float4> colors,
                      std::initializer_list<double> views) {
   for (float metallic : {0.0f, 0.5f, 1.0f})
     for (float roughness : roughnesses)
-      for (float4 color : {kWhite, kSaturated})
+      for (float4 color : colors)
         for (double view : views) check_bsdf(bsdf_config(metallic, roughness, color, view));
 }
 
 TEST(Sampling, GltfBrdf) {
-  check_gltf_brdf({0.1f, 0.6f}, {0.0, 80.0});
+  check_gltf_brdf({0.1f, 0.6f}, {kSaturated}, {0.0, 80.0});
 }
 TEST(Sampling, GltfBrdfExhaustive) {
-  check_gltf_brdf({0.1f, 0.3f, 0.6f, 1.0f}, {0.0, 45.0, 80.0});
+  check_gltf_brdf({0.1f, 0.3f, 0.6f, 1.0f}, {kWhite, kSaturated}, {0.0, 45.0, 80.0});
 }
 
 // Roughness 0: the specular layer is a delta lobe; bsdf_eval's pdf is then the diffuse part
@@ -1095,23 +1095,31 @@ TEST(Sampling, Sheen) {
 // degrees from wo's azimuth, every pair on a metal; on glass (thin-walled, entering a volume,
 // leaving it: three code paths) each pair once, a Latin square, so that each path sees every
 // strength and every rotation (all 27 would add ~10 s of CPU time); one narrow lobe (alpha 0.01
-// across the direction).
-TEST(Sampling, Anisotropy) {
+// across the direction). The default suite takes the metal's pairs as a Latin square too (each
+// strength and rotation once), ...Exhaustive (slow) all nine.
+void check_anisotropy(bool every_metal_pair) {
   const float strengths[3] = {0.3f, 0.8f, 1.0f};
   const double rotations[3] = {0.0, 30.0, 90.0};
   const Config metal = bsdf_config(1, 0.3f, kSaturated, 45);
   const Config glass[3] = {bsdf_config(0, 0.3f, kWhite, 45, 1, kFront),
                            bsdf_config(0, 0.3f, kWhite, 45, 1, kVolume | kFront),
                            bsdf_config(0, 0.3f, kWhite, 30, 1, kVolume)};
-  for (float strength : strengths)
-    for (double rotation : rotations)
-      check_bsdf(with_samples(with_aniso(metal, strength, rotation), kSweepSamples));
+  for (int k = 0; k < 3; ++k)
+    for (int r = 0; r < 3; ++r)
+      if (every_metal_pair || r == k)
+        check_bsdf(with_samples(with_aniso(metal, strengths[k], rotations[r]), kSweepSamples));
   for (int g = 0; g < 3; ++g)
     for (int k = 0; k < 3; ++k)
       check_bsdf(
           with_samples(with_aniso(glass[g], strengths[k], rotations[(k + g) % 3]), kSweepSamples));
   check_bsdf(
       with_samples(with_aniso(bsdf_config(1, 0.1f, kSaturated, 45), 0.8f, 30), kLayeredSamples));
+}
+TEST(Sampling, Anisotropy) {
+  check_anisotropy(false);
+}
+TEST(Sampling, AnisotropyExhaustive) {
+  check_anisotropy(true);
 }
 
 // KHR_materials_diffuse_transmission: thin-walled and into (and out of) a volume, with and without

@@ -61,7 +61,7 @@ fi
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
-if ((tests)) && [[ ${WP_FUZZ_SECONDS:-5} != 0 ]] && tools/fuzz.sh --check; then
+if ((tests)) && [[ ${WP_FUZZ_SECONDS:-3} != 0 ]] && tools/fuzz.sh --check; then
   echo "wavepath: building the fuzz targets (build-fuzz/)" >&2
   tools/fuzz.sh --build
 fi

@@ -4,7 +4,7 @@
 # and timings in docs/testing.md:
 #   tools/test.sh [CTEST_ARGS...]          the default suite: unit, kernel, sampling, energy, scene,
 #                                          bench, oclgrind, gpu (two representative variants) and
-#                                          fuzz (WP_FUZZ_SECONDS per target, default 5; 0 skips
+#                                          fuzz (WP_FUZZ_SECONDS per target, default 3; 0 skips
 #                                          them), without the tests also labelled slow
 #   tools/test.sh --quick [CTEST_ARGS...]  the developer loop: the unit, kernel and sampling tiers
 #                                          (host code, every kernel against its host reference,
@@ -38,7 +38,7 @@ if [[ $tier == quick ]]; then
   args+=(-L 'unit|kernel|sampling' -LE slow)
 else
   [[ $tier == default ]] && args+=(-LE slow)
-  fuzz_seconds=${WP_FUZZ_SECONDS:-5}
+  fuzz_seconds=${WP_FUZZ_SECONDS:-3}
   if [[ $fuzz_seconds == 0 ]]; then
     echo "wavepath: fuzzing skipped (WP_FUZZ_SECONDS=0)"
   elif ! tools/fuzz.sh --check; then

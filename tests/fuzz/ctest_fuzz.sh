@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # ctest's fuzz tier (tests/CMakeLists.txt): `ctest_fuzz.sh --build` builds the fuzz targets
-# (tools/fuzz.sh --build), `ctest_fuzz.sh TARGET` runs one for $WP_FUZZ_SECONDS (default 5;
+# (tools/fuzz.sh --build), `ctest_fuzz.sh TARGET` runs one for $WP_FUZZ_SECONDS (default 3;
 # tools/fuzz.sh --run). Exits 77, ctest's skip, when WP_FUZZ_SECONDS is 0 or clang++ cannot build
 # libFuzzer targets.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
-seconds=${WP_FUZZ_SECONDS:-5}
+seconds=${WP_FUZZ_SECONDS:-3}
 if ! [[ $seconds =~ ^[0-9]+$ ]]; then
   echo "wavepath fuzz: WP_FUZZ_SECONDS must be a whole number of seconds, not '$seconds'" >&2
   exit 2
