@@ -36,7 +36,7 @@
  *               as it was.
  * Why an eighth: the samples of a pixel are already spread over it (box filter) and each scattered
  * sample's neighbours over its lobe, so a cone as wide as a whole footprint blurs the image twice
- * over. Measured on DamagedHelmet seen small (tools/mip_study.py's case, 256 x 256, the model ~50
+ * over. Measured on DamagedHelmet seen small (tools/studies/mip_study.py's case, 256 x 256, the model ~50
  * pixels across, 1024 spp): the mip-mapped image converges to a relMSE of 9.3e-5 from the
  * unfiltered one with an eighth (pbrt-v4's smallest scale of its ray differentials too), 2.4e-4
  * with a quarter (0.0064 with whole footprints, measured with the major axis's level), while its

@@ -235,7 +235,7 @@ PLANE_ALBEDO = (0.8, 0.8, 0.8)
 
 def punctual():
     """A point and a spot light over a Lambertian plane, seen from straight above: the image is
-    known in closed form (tools/closed_form.py)."""
+    known in closed form (tools/wavepath_tools/closed_form.py)."""
     b = GltfBuilder()
     _lambert_plane(b, 2.0, 1.5, PLANE_ALBEDO)
     point_pos, point_col, point_i = (-1.0, 0.8, -0.3), (1.0, 0.85, 0.7), 1.5

@@ -3,9 +3,9 @@
 
     test_accuracy.py --wavepath build/wavepath [--scene NAME ...] [--cache DIR] [--verbose]
 
-For each scene, every configuration of tools/accuracy_lib.DEFAULT_CONFIGS (mis, nee, bsdf, the
+For each scene, every configuration of tools/wavepath_tools/accuracy_lib.DEFAULT_CONFIGS (mis, nee, bsdf, the
 balance heuristic, uniform light selection, no roulette, roulette after 1 event) is rendered at
-TEST_W x TEST_H and compared with the scene's reference (tools/accuracy_lib.reference: closed
+TEST_W x TEST_H and compared with the scene's reference (tools/wavepath_tools/accuracy_lib.reference: closed
 form, black, or an MIS render of REF_SPP samples per pixel, cached beside the binary).
 
 (a) Unbiasedness. Each configuration's image mean, per channel, agrees with the reference's:
@@ -40,8 +40,8 @@ import os
 import sys
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(REPO, "tools"))
-import system_python  # noqa: E402
+sys.path.insert(0, os.path.join(REPO, "tools"))  # the root of the wavepath_tools package
+from wavepath_tools import system_python  # noqa: E402
 
 system_python.need_numpy("test_accuracy.py")
 
@@ -50,8 +50,8 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-import accuracy_lib as al  # noqa: E402
-import closed_form  # noqa: E402
+from wavepath_tools import accuracy_lib as al  # noqa: E402
+from wavepath_tools import closed_form  # noqa: E402
 
 TEST_W, TEST_H = 48, 36
 REF_SPP = 1024
@@ -89,7 +89,7 @@ class Failures:
 
 
 def check_closed_form(f):
-    """Lambert's formula (tools/closed_form.py) against a midpoint-rule integral of
+    """Lambert's formula (tools/wavepath_tools/closed_form.py) against a midpoint-rule integral of
     L cos(theta) cos(theta') / d^2 over the lambert_quad scene's emitters, at three points."""
     manifest = al.load_manifest()
     model = manifest["by_name"]["lambert_quad"]["reference"]["model"]

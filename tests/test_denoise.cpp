@@ -163,7 +163,7 @@ TEST_F(DenoiseCli, WritesTheDenoisedImageBesideEachImageOutput) {
   EXPECT_FALSE(fs::exists(path("n.exr")));
 }
 
-// (b) Accuracy: relMSE against a converged reference, as tools/accuracy_lib.py measures it:
+// (b) Accuracy: relMSE against a converged reference, as tools/wavepath_tools/accuracy_lib.py measures it:
 // mean over pixels and channels of ((x - r)^2 - v_r) / (r^2 + 0.01), where the reference's own
 // variance v_r (--variance) is subtracted because its noise adds v_r to (x - r)^2 on average.
 double rel_mse(const wp::ImageRgb& x, const wp::ImageRgb& r, const wp::ImageRgb& v_r) {

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Self-test of tools/peers_scene.py, the glTF converter of tools/peers.py (stdlib unittest only;
+"""Self-test of tools/wavepath_tools/peers_scene.py, the glTF converter of tools/peers.py (stdlib unittest only;
 no PyPI, no renderer).
 
     python3 tests/test_peers_scene.py
@@ -14,7 +14,7 @@ reversed) on a scene written with scenes/gltf_builder.py as .glb; refusals of wh
 cannot represent; the PLY writer read back; for --pbr, world-space bounds, wavepath's framing
 camera, and the copy with that camera written in (.glb and .gltf, read back). Coincident emitters
 (an emitter coplanar with another surface and overlapping it) are found and refused: the
-many-light room of tools/make_many_lights.py converts with its lamps on a grid, and is refused with
+many-light room of scenes/make_many_lights.py converts with its lamps on a grid, and is refused with
 them at random (overlapping) positions or flush with the ceiling.
 """
 
@@ -26,12 +26,12 @@ import tempfile
 import unittest
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(REPO, "tools"))
+sys.path.insert(0, os.path.join(REPO, "tools"))  # the root of the wavepath_tools package
 sys.path.insert(0, os.path.join(REPO, "scenes"))
 
 import gltf_builder as gb  # noqa: E402
 import make_many_lights as mml  # noqa: E402
-import peers_scene as ps  # noqa: E402
+from wavepath_tools import peers_scene as ps  # noqa: E402
 
 BOX = os.path.join(REPO, "scenes", "cornell_box.gltf")
 BOX_POINT = os.path.join(REPO, "scenes", "cornell_box_point.gltf")

@@ -626,7 +626,7 @@ TEST(Sampling, CosSinTurn) {
 // zeros. The bound, summed over the steps: the quotient a = min/max, correctly rounded on PoCL
 // (Elementary's comment below says more), rounds by at most 2^-24 a
 // (6e-8 in the angle, as atan' <= 1); the polynomial with float coefficients, evaluated by Horner
-// in float, is within 1.1e-7 of atan on [0, 1] (tools/gen_atan_poly.py, at 4 million points);
+// in float, is within 1.1e-7 of atan on [0, 1] (tools/generators/gen_atan_poly.py, at 4 million points);
 // pi/2 - r and pi - r round by at most half an ulp of results below 2 and 4 (6e-8, 1.2e-7) with
 // the float constants pi/2 and pi off by 4.4e-8 and 8.8e-8: 4.8e-7 in all. Exact where the
 // octant's angle is: 0, +-pi/2 and +-pi on the axes (float pi/2 and pi, as the library gives),

@@ -1,6 +1,6 @@
 // The KHR_materials_sheen lobe (kernels/sheen.h) on the device against this file's float64
 // evaluation of the extension's formulas (sheen.h's header; written from the formulas, not from
-// sheen.h's code), and the albedo table (kernels/sheen_table.h, tools/gen_sheen_table.py) against
+// sheen.h's code), and the albedo table (kernels/sheen_table.h, tools/generators/gen_sheen_table.py) against
 // an independent quadrature.
 //
 // The reference albedo integrates over the microfacet normal h, where the generator integrates over

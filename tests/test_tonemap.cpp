@@ -1,12 +1,12 @@
 // unit: the PNG tonemaps (host/film/tonemap.h) against their published definitions, known answers
 // and Blender's own view transforms.
 //
-// tests/data/tonemap_reference.csv: tools/tonemap_reference.py's float64 transcriptions of
+// tests/data/tonemap_reference.csv: tools/generators/tonemap_reference.py's float64 transcriptions of
 // three.js's AgX, the Khronos PBR Neutral text, Narkowicz's ACES fit and the clamp, on a grey ramp
 // (0 and 2^-12 .. 16 in quarter stops), primaries and secondaries, hue sweeps and small-minimum
 // colours (the ctest tonemap_reference_py checks that the file is still the script's output).
 // tests/data/tonemap_blender.csv: the same colours through Blender's "AgX" and "Khronos PBR
-// Neutral" views (tools/tonemap_blender.py), 8-bit.
+// Neutral" views (tools/generators/tonemap_blender.py), 8-bit.
 #include <algorithm>
 #include <cmath>
 #include <fstream>

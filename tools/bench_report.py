@@ -31,7 +31,7 @@ import re
 import subprocess
 import sys
 
-from stage_names import stage_names
+from wavepath_tools.stage_names import stage_names
 
 STAGES = stage_names()  # host/render/pipeline.h's kStageNames
 END_TO_END = ["render", "bvh_build", "program_build"]

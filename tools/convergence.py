@@ -11,22 +11,19 @@ running interpreter lacks numpy and /usr/bin/python3 exists, the script re-runs 
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import system_python  # noqa: E402
+from wavepath_tools import system_python  # noqa: E402
 
 system_python.need_numpy("convergence.py", "python3-numpy and python3-matplotlib")
 
 import argparse  # noqa: E402
 import csv  # noqa: E402
-import json  # noqa: E402
 import math  # noqa: E402
 import re  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import accuracy_lib as al  # noqa: E402
+from wavepath_tools import accuracy_lib as al  # noqa: E402
 
 DESCRIPTION = """\
 Renders a scene with each configuration at every sample count, and records for each run the wall
@@ -42,7 +39,7 @@ file output) and the error against a reference:
            each pixel's estimate); z = bias / its standard error. Bias is reported apart from
            noise: an unbiased configuration has |z| of order 1 at every sample count.
 
-The reference is, per scene of the manifest: the closed form (tools/closed_form.py) where there is
+The reference is, per scene of the manifest: the closed form (tools/wavepath_tools/closed_form.py) where there is
 one, black for the closed box, another scene's reference for the scaled scenes (radiance does not
 depend on scale), otherwise an MIS render of --ref-spp samples per pixel with its own seed, cached
 in --cache under a key of the scene file (and files its arguments name), the arguments, size,
@@ -306,7 +303,7 @@ def read_csv(path):
 
 def reference_description(manifest, name, ref_spp):
     ref = manifest["by_name"][name].get("reference", {"kind": "render"})
-    return {"closed_form": "closed form (tools/closed_form.py)",
+    return {"closed_form": "closed form (tools/wavepath_tools/closed_form.py)",
             "black": "black: nothing can reach the inside",
             "scene": "%s's MIS reference (%d spp): the same scene at scale 1" %
                      (ref.get("scene"), ref_spp)}.get(ref["kind"], "MIS render, %d spp" % ref_spp)

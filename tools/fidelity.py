@@ -35,9 +35,8 @@ import types
 
 TOOLS = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(TOOLS)
-sys.path.insert(0, TOOLS)
-import peers  # noqa: E402
-import peers_scene  # noqa: E402
+import peers  # noqa: E402  (tools/, this script's folder)
+from wavepath_tools import peers_scene  # noqa: E402
 
 MODELS = ("ClearCoatTest", "ClearCoatCarPaint", "SpecularTest", "SheenChair", "GlamVelvetSofa",
           "AnisotropyStrengthTest", "AnisotropyRotationTest", "IridescenceLamp",
@@ -326,7 +325,7 @@ def render_wavepath(a, scene, work, name):
     """wavepath's converged image: --spp independent samples (so that its variance image is the
     error's) with --variance. {"img", "var", "seconds", "ignored": [extensions it warned it
     ignores]} or {"refused": its error line, "seconds"}."""
-    import accuracy_lib as al
+    from wavepath_tools import accuracy_lib as al
     out = os.path.join(work, "wavepath.pfm")
     cmd = ([a.wavepath, "render", scene, "--width", str(a.width), "--height", str(a.height),
             "--spp", str(a.spp), "--seed", str(al.REFERENCE_SEED), "--max-depth",

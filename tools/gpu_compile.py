@@ -49,7 +49,7 @@ import subprocess
 import sys
 import tempfile
 
-from stage_names import stage_names
+from wavepath_tools.stage_names import stage_names
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNELS = os.path.join(ROOT, "kernels")

@@ -13,7 +13,7 @@ Run `tools/peers.py --help` for the options. Not part of tools/test.sh: the peer
 libLLVM shared library (DRJIT_LIBLLVM_PATH when set, else the newest
 /usr/lib/x86_64-linux-gnu/libLLVM-*.so*; Debian: libllvm19, with which it was run: with LLVM 15,
 Dr.Jit 1.5's kernels stop with "LLVM ERROR: Cannot select ... fminimum"); bpy 5.0 needs Python
-3.11 (--python). The converter is tools/peers_scene.py, tested by tests/test_peers_scene.py.
+3.11 (--python). The converter is tools/wavepath_tools/peers_scene.py, tested by tests/test_peers_scene.py.
 """
 
 import argparse
@@ -30,8 +30,7 @@ import time
 
 TOOLS = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(TOOLS)
-sys.path.insert(0, TOOLS)
-import peers_scene  # noqa: E402
+from wavepath_tools import peers_scene  # noqa: E402
 
 PACKAGES = {"mitsuba": ["mitsuba"], "mitsuba-ld": ["mitsuba"], "cycles": ["bpy"]}
 BASE_PACKAGES = ["numpy", "matplotlib"]
@@ -44,7 +43,7 @@ MITSUBA_SAMPLERS = {"mitsuba": "independent", "mitsuba-ld": "ldsampler"}
 VENV_MARK = "WP_PEERS_IN_VENV"
 
 DESCRIPTION = """\
-Converts the scene (tools/peers_scene.py: world-space triangle meshes, Lambertian materials,
+Converts the scene (tools/wavepath_tools/peers_scene.py: world-space triangle meshes, Lambertian materials,
 emitters, point lights, the first perspective camera; anything else is refused, and so is an
 emitter coplanar with and overlapping another surface, which each renderer resolves its own way:
 docs/peers.md, notes) for each peer.
@@ -84,7 +83,7 @@ PBR MODE (--pbr; --renderers wavepath,cycles): the scene is not converted but gi
 renderer as the glTF file it is, textures and metallic-roughness materials included, optionally
 under an environment map (--env, --env-intensity, --env-rotation, wavepath's options). A file
 without a camera is rendered by both from a copy with wavepath's framing camera written into it
-(tools/peers_scene.py: bounds, framing_camera, with_camera; --work/with_camera.glb).
+(tools/wavepath_tools/peers_scene.py: bounds, framing_camera, with_camera; --work/with_camera.glb).
   Cycles     bpy.ops.import_scene.gltf (Blender's glTF importer, shipped with bpy): Principled
              BSDFs, set to single-scatter GGX (`distribution` GGX; Blender's default is
              multiscatter) with subsurface weight 0; a material the importer marks as
@@ -118,7 +117,7 @@ Each renderer renders the sweep of --spp counts; each run is a separate process 
 from start to the image on disk (start-up, kernel or JIT compilation, scene load included), is
 measured by this script. One unmeasured 1-spp run of each renderer first fills the caches that
 persist between processes (wavepath's kernel binary and BVH caches, Dr.Jit's kernel cache), so that
-no measured run pays a one-off compilation. relMSE is tools/accuracy_lib.py's: mean(((x - r)^2 -
+no measured run pays a one-off compilation. relMSE is tools/wavepath_tools/accuracy_lib.py's: mean(((x - r)^2 -
 var_r) / (r^2 + 0.01)) against one common reference (without --pbr), a wavepath render of --ref-spp
 samples with its variance image (so the reference's own noise is subtracted). The conversion is
 checked by the image means: each peer's largest run against the reference, per channel (their
@@ -643,7 +642,7 @@ def convert(a):
 def run_one(a, renderer, spp, seed, scene_json, env, name=None):
     """(wall seconds, image top row first, CPU seconds)."""
     import numpy as np
-    import accuracy_lib as al
+    from wavepath_tools import accuracy_lib as al
     out = os.path.join(a.work, "%s-%s.npy" % (renderer, name or spp))
     if renderer == "wavepath":
         pfm = out[:-4] + ".pfm"
@@ -667,7 +666,7 @@ def run_one(a, renderer, spp, seed, scene_json, env, name=None):
 def reference(a):
     """(image, variance) of the wavepath reference, cached in --work by its settings."""
     import numpy as np
-    import accuracy_lib as al
+    from wavepath_tools import accuracy_lib as al
     h = hashlib.sha256()
     with open(a.render_scene, "rb") as f:
         h.update(f.read())
@@ -917,10 +916,10 @@ def write_doc(a, rows, checks, ref_seconds, vers, chart_name, load):
          "Time is the wall time of each render's whole process (start-up, kernel or JIT "
          "compilation, scene load, rendering, writing the image), measured by the script; "
          "relMSE = mean(((x − r)² − var_r) / (r² + 0.01)) against the common reference "
-         "(tools/accuracy_lib.py). One unmeasured 1-spp run of each renderer first fills the "
+         "(tools/wavepath_tools/accuracy_lib.py). One unmeasured 1-spp run of each renderer first fills the "
          "caches kept between processes (wavepath's kernel binary and BVH, Dr.Jit's kernels)."
          + _repeat_sentence(a), "",
-         "The scene is converted exactly (`tools/peers_scene.py`, tested by "
+         "The scene is converted exactly (`tools/wavepath_tools/peers_scene.py`, tested by "
          "`tests/test_peers_scene.py`; the mapping is in `tools/peers.py --help`): triangle "
          "meshes, Lambertian reflectance, the emissive quad as a one-sided area light with the "
          "same radiance, the camera's vertical field of view, a one-pixel box filter, the same "
@@ -1050,9 +1049,9 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "build and texture loading), writing an EXR and reading it back into a NumPy file; "
          "also after an unmeasured 1-spp run." + _repeat_sentence(a), "",
          "**Each renderer's error is measured against its own reference** (relMSE = "
-         "mean(((x − r)² − var_r) / (r² + 0.01)), tools/accuracy_lib.py, with r and var_r that "
+         "mean(((x − r)² − var_r) / (r² + 0.01)), tools/wavepath_tools/accuracy_lib.py, with r and var_r that "
          "renderer's reference and its variance image; wavepath's reference is rendered with "
-         "independent samples, as tools/accuracy_lib.py renders references, because only then "
+         "independent samples, as tools/wavepath_tools/accuracy_lib.py renders references, because only then "
          "is its variance image the error's, while the sweep runs use wavepath's default "
          "sampler; Cycles' variance image is the spread of independently seeded runs, right "
          "for any sampler, and all its runs use its default sampler): the two do not render exactly the same "
@@ -1141,7 +1140,7 @@ def main(argv):
     a = parse_args(argv)
     ensure_venv(a)
     import numpy as np
-    import accuracy_lib as al
+    from wavepath_tools import accuracy_lib as al
 
     env = dict(os.environ)
     if any(r in a.renderers for r in MITSUBA_SAMPLERS) and a.mitsuba_variant.startswith("llvm"):

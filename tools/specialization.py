@@ -8,7 +8,7 @@ cache again), and the size of the program binary. Prints a Markdown table (the
 specialisation table of docs/performance.md) with the machine, the device and this command line.
 
 With --extensions it measures what the material extensions cost instead: each scene (a model that
-uses some) rendered as it is and from a copy without those extensions (tools/peers_scene.py's
+uses some) rendered as it is and from a copy without those extensions (tools/wavepath_tools/peers_scene.py's
 copy_gltf, into a temporary folder), both with kernels for their own features; the extensions are
 the layered ones (specular, clearcoat, sheen, anisotropy, iridescence, diffuse transmission,
 dispersion), each a kernel feature of its own.
@@ -27,8 +27,7 @@ import subprocess
 import sys
 import tempfile
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import peers_scene  # noqa: E402
+from wavepath_tools import peers_scene  # noqa: E402
 
 # The material extensions that are kernel features of their own (kernels/features.h).
 LAYERED = ("KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen",

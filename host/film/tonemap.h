@@ -1,6 +1,6 @@
 // The PNG output's display transform: exposure, a tonemap, then the sRGB encoding (IEC 61966-2-1)
 // into 8 bits. Input is linear Rec.709 (the film's space); every tonemap here outputs linear
-// Rec.709 for the one sRGB encoding that follows. tools/tonemap_reference.py holds float64
+// Rec.709 for the one sRGB encoding that follows. tools/generators/tonemap_reference.py holds float64
 // transcriptions of the published definitions that tests/test_tonemap.cpp checks these against.
 #pragma once
 

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""Blender's own view transforms on tools/tonemap_reference.py's colours, for
+"""Blender's own view transforms on tools/generators/tonemap_reference.py's colours, for
 tests/data/tonemap_blender.csv (read by tests/test_tonemap.cpp): the colours as a one-row float
 image in Blender's scene linear space (Linear Rec.709), saved as an 8-bit PNG through the sRGB
 display's "AgX" and "Khronos PBR Neutral" views (look None, exposure 0, gamma 1, no dither), and
 read back. Needs Blender as a Python module (PyPI's bpy, Python 3.11) and numpy:
 
   python3.11 -m venv /tmp/bpy && /tmp/bpy/bin/pip install bpy numpy
-  /tmp/bpy/bin/python tools/tonemap_blender.py > tests/data/tonemap_blender.csv
+  /tmp/bpy/bin/python -m tools.generators.tonemap_blender > tests/data/tonemap_blender.csv
 
 The first line names Blender's version. Prints to stderr, per view, the largest difference from the reference's 8-bit
 codes (greys and all colours). Blender's "Khronos PBR Neutral" is a 3D LUT fitted to the same
@@ -21,8 +21,7 @@ import tempfile
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import tonemap_reference as ref  # noqa: E402
+from tools.generators import tonemap_reference as ref  # noqa: E402
 
 VIEWS = {"agx": "AgX", "pbr-neutral": "Khronos PBR Neutral"}
 
@@ -56,7 +55,7 @@ def main():
     for line in ref.table().splitlines()[1:]:
         f = line.split(",")
         reference.setdefault(f[0], []).append([int(v) for v in f[7:]])
-    print("# Blender %s, tools/tonemap_blender.py" % bpy.app.version_string)
+    print("# Blender %s, tools/generators/tonemap_blender.py" % bpy.app.version_string)
     print("mapper,r,g,b,code_r,code_g,code_b")
     for name, view in VIEWS.items():
         codes = blender_codes(colours, view)

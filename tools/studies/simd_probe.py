@@ -20,17 +20,17 @@ The rays are wrong beyond the first store (a probe, not a renderer): the later s
 meaningless, the camera stage's (--profile) is what is compared. The real kernel is timed too.
 
 --layout-cost measures what the "arrays" layout costs the kernels as they are (no SIMD across
-paths): tools/simd_probe_layout.patch changes only the path-state accessors (path_state.h) and
+paths): tools/studies/simd_probe_layout.patch changes only the path-state accessors (path_state.h) and
 the cache hints (stage.h) to one array per component within each field's buffer, and whole
 renders with it are timed against the kernels of the tree, alternated run by run; both must give
 the same image bit for bit (checked).
 
-  tools/simd_probe.py                      the table of docs/performance.md (5 alternated rounds)
-  tools/simd_probe.py --rounds 9 --spp 128
-  tools/simd_probe.py --layout-cost        the layout's cost to the whole pipeline (5 runs each
+  python3 -m tools.studies.simd_probe                      the table of docs/performance.md (5 alternated rounds)
+  python3 -m tools.studies.simd_probe --rounds 9 --spp 128
+  python3 -m tools.studies.simd_probe --layout-cost        the layout's cost to the whole pipeline (5 runs each
                                            of the Cornell box, its Lambertian copy and
                                            DamagedHelmet when ../shared/assets has it)
-  tools/simd_probe.py --check              the ctest: writes the variants, applies the layout
+  python3 -m tools.studies.simd_probe --check              the ctest: writes the variants, applies the layout
                                            patch and compiles one variant, which must get a
                                            verdict (fails when the kernels no longer have what
                                            the probe changes, or the probe no longer builds);
@@ -51,11 +51,10 @@ import subprocess
 import sys
 import tempfile
 
-import peers_scene
-import vectorization
+from tools.wavepath_tools import peers_scene, pocl_remarks
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LAYOUT_PATCH = os.path.join(ROOT, "tools", "simd_probe_layout.patch")
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+LAYOUT_PATCH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "simd_probe_layout.patch")
 HELMET = os.path.join(ROOT, "..", "shared", "assets", "models", "DamagedHelmet",
                       "DamagedHelmet.glb")
 KERNELS = os.path.join(ROOT, "kernels")
@@ -127,7 +126,7 @@ def make_variant(folder, rng, layout):
 
 
 def make_arrays_layout(folder):
-    """kernels/ with the path state in one array per component (tools/simd_probe_layout.patch)."""
+    """kernels/ with the path state in one array per component (tools/studies/simd_probe_layout.patch)."""
     shutil.copytree(KERNELS, folder)
     env = dict(os.environ, GIT_CEILING_DIRECTORIES=os.path.dirname(folder))
     p = subprocess.run(["git", "apply", "-p2", LAYOUT_PATCH], cwd=folder, env=env,
@@ -180,17 +179,17 @@ def run(wavepath, scene, args, env_extra):
 
 
 def verdict(wavepath, scene, kernel_dir, tmp):
-    """LLVM's verdict on generate_camera_rays' work-item loop (vectorization.py's reading)."""
+    """LLVM's verdict on generate_camera_rays' work-item loop (tools/wavepath_tools/pocl_remarks.py's reading)."""
     cache = tempfile.mkdtemp(dir=tmp)
     env = {"POCL_CACHE_DIR": cache, "POCL_VECTORIZER_REMARKS": "1"}
     if kernel_dir:
         env["WAVEPATH_KERNEL_DIR"] = kernel_dir
     p = run(wavepath, scene, ["--width", "16", "--height", "16", "--spp", "1", "--no-kernel-cache",
                               "-o", os.path.join(tmp, "v.pfm")], env)
-    k = vectorization.analyse(p.stdout + p.stderr).get("generate_camera_rays")
+    k = pocl_remarks.analyse(p.stdout + p.stderr).get("generate_camera_rays")
     if not k:
         fail("no remarks for generate_camera_rays")
-    v = vectorization.verdict(k)
+    v = pocl_remarks.verdict(k)
     if not v:
         fail("generate_camera_rays' work-item loop got no verdict")
     return v
@@ -210,7 +209,7 @@ def main():
     p.add_argument("--layout-cost", action="store_true",
                    help="time whole renders with the arrays layout (default --spp 16)")
     a = p.parse_args()
-    device, row = vectorization.default_device(a.wavepath)
+    device, row = pocl_remarks.default_device(a.wavepath)
     if device is None or "Portable Computing Language" not in row:
         fail(f"wavepath's default device ({device or 'none'}) is not PoCL's", 77)
     if a.layout_cost:

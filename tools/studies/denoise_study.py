@@ -3,12 +3,12 @@
 against a converged reference, on the scenes of tests/test_denoise.cpp and one where the denoiser
 gains little.
 
-    tools/denoise_study.py [--wavepath build/wavepath] [--size 128] [--spp 16] [--ref-spp 4096]
+    python3 -m tools.studies.denoise_study [--wavepath build/wavepath] [--size 128] [--spp 16] [--ref-spp 4096]
                            [--seeds 5] [--assets ../shared/assets]
 
 For each scene: one reference (--ref-spp samples, --variance, seed REFERENCE_SEED, which no
 compared render uses), then --seeds renders of --spp samples with --denoise (seeds 1..N), each
-compared with the reference as tools/accuracy_lib.py does: relMSE = mean over pixels and channels
+compared with the reference as tools/wavepath_tools/accuracy_lib.py does: relMSE = mean over pixels and channels
 of ((x - r)^2 - v_r) / (r^2 + 0.01), v_r the reference's variance (subtracted: the reference's
 own noise adds v_r to (x - r)^2 on average). Prints a Markdown table (mean, min and max over the
 seeds) and the commands it ran (S: each seed). Needs Open Image Denoise (tools/setup.sh --denoise).
@@ -20,13 +20,12 @@ import subprocess
 import sys
 import tempfile
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from system_python import need_numpy  # noqa: E402
+from tools.wavepath_tools.system_python import need_numpy  # noqa: E402
 
 need_numpy("denoise_study.py")
 import numpy as np  # noqa: E402
 
-from accuracy_lib import REFERENCE_SEED, REL_EPS, REPO, read_pfm  # noqa: E402
+from tools.wavepath_tools.accuracy_lib import REFERENCE_SEED, REL_EPS, REPO, read_pfm  # noqa: E402
 
 # name, scene (relative to the repository, or "assets:" + a path under the assets folder), options.
 SCENES = [

@@ -5,8 +5,8 @@ list of their own."""
 import os
 import re
 
-_PIPELINE_H = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "host",
-                           "render", "pipeline.h")
+_REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+_PIPELINE_H = os.path.join(_REPO, "host", "render", "pipeline.h")
 
 
 def stage_names():

@@ -19,7 +19,7 @@ Renders alternate (on, off) for each seed, so a slow minute on a shared machine 
 alike. Prints Markdown tables; with --chart FILE also plots relMSE against seconds (matplotlib).
 Needs numpy (Debian: python3-numpy).
 
-  tools/mip_study.py [--wavepath build/wavepath] [--size 256] [--spp 1,4,16,64] [--seeds 3]
+  python3 -m tools.studies.mip_study [--wavepath build/wavepath] [--size 256] [--spp 1,4,16,64] [--seeds 3]
                      [--ref-spp 2048] [--chart docs/mipmaps.png]
                      [--case NAME:SCENE:ARGS ...]
 """
@@ -29,14 +29,13 @@ import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import system_python  # noqa: E402
+from tools.wavepath_tools import system_python  # noqa: E402
 
 system_python.need_numpy("mip_study.py")
 
 import numpy as np  # noqa: E402
 
-import accuracy_lib  # noqa: E402
+from tools.wavepath_tools import accuracy_lib  # noqa: E402
 
 REFERENCE_SEED = 0x5EEDF00D
 ASSETS = os.path.join(accuracy_lib.REPO, "..", "shared", "assets")

@@ -16,7 +16,7 @@ var_r needs). Renders are interleaved (pattern after pattern for each seed), so 
 shared machine touches every pattern alike. Prints a Markdown table. Needs numpy (Debian:
 python3-numpy).
 
-  tools/sampler_study.py [--wavepath build/wavepath] [--scene FILE ...] [--size 128]
+  python3 -m tools.studies.sampler_study [--wavepath build/wavepath] [--scene FILE ...] [--size 128]
                          [--spp 64,256] [--seeds 12] [--ref-spp 4096]
                          [--samplers sobol,sobol-padded]
 """
@@ -26,14 +26,13 @@ import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import system_python  # noqa: E402
+from tools.wavepath_tools import system_python  # noqa: E402
 
 system_python.need_numpy("sampler_study.py")
 
 import numpy as np  # noqa: E402
 
-import accuracy_lib  # noqa: E402
+from tools.wavepath_tools import accuracy_lib  # noqa: E402
 
 REFERENCE_SEED = 0x5EEDF00D
 

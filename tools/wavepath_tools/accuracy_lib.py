@@ -23,12 +23,11 @@ import json
 import os
 import re
 import subprocess
-import sys
 import tempfile
 
 import numpy as np
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_MANIFEST = os.path.join(REPO, "scenes", "failure", "manifest.json")
 REL_EPS = 0.01
 REFERENCE_SEED = 987654321  # never used for the runs compared with a reference
@@ -169,10 +168,9 @@ def reference(wavepath, manifest, name, width, height, spp, cache_dir, log=None)
     ref = entry.get("reference", {"kind": "render"})
     kind = ref["kind"]
     if kind == "closed_form":
-        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-        import closed_form
+        from . import closed_form
         img = closed_form.image(ref["model"], width, height)
-        return img, np.zeros_like(img), "closed form (tools/closed_form.py)"
+        return img, np.zeros_like(img), "closed form (tools/wavepath_tools/closed_form.py)"
     if kind == "black":
         img = np.zeros((height, width, 3))
         return img, np.zeros_like(img), "black: nothing can reach the inside"

@@ -2,7 +2,7 @@
 buffers, or .glb) into a renderer-neutral description that Mitsuba 3 and Cycles are built from.
 Standard library only, so that tests/test_peers_scene.py runs without PyPI.
 
-    import peers_scene
+    from wavepath_tools import peers_scene
     scene = peers_scene.load("scenes/cornell_box.gltf")
     scene["meshes"]        # [{"name", "material", "positions": [(x, y, z)...] in world space,
                            #   "triangles": [(i, j, k)...]}], one per triangle primitive

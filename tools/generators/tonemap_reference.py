@@ -17,18 +17,16 @@ Every row: mapper, the input R,G,B (float32 values, printed so that they read ba
 sRGB-encoded output in [0, 1] (IEC 61966-2-1, after clamping to [0, 1]) and its 8-bit PNG code
 (round half up of 255 * value).
 
-  python3 tools/tonemap_reference.py > tests/data/tonemap_reference.csv
-  python3 tools/tonemap_reference.py --check tests/data/tonemap_reference.csv
+  python3 -m tools.generators.tonemap_reference > tests/data/tonemap_reference.csv
+  python3 -m tools.generators.tonemap_reference --check tests/data/tonemap_reference.csv
 """
 
 import argparse
 import colorsys
 import io
-import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import system_python  # noqa: E402
+from tools.wavepath_tools import system_python  # noqa: E402
 
 system_python.need_numpy("tonemap_reference.py")
 import numpy as np  # noqa: E402

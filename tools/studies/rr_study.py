@@ -20,7 +20,7 @@ are pooled over the repetitions (different seeds). Shadow rays are not in the ra
 follow the closest-hit rays one for one (at most), so the ratio of costs is close. Prints a Markdown
 table.
 
-  tools/rr_study.py [--wavepath build/wavepath] [--scene FILE ...] [--size 256] [--spp 64]
+  python3 -m tools.studies.rr_study [--wavepath build/wavepath] [--scene FILE ...] [--size 256] [--spp 64]
                     [--repeat 3] [--depths 1,2,3,4,5,6,8] [--thresholds 1]
 
 The default threshold, 1, is the rule the study in docs/accuracy.md ran with (survival
@@ -32,14 +32,13 @@ import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import system_python  # noqa: E402
+from tools.wavepath_tools import system_python  # noqa: E402
 
 system_python.need_numpy("rr_study.py")
 
 import numpy as np  # noqa: E402
 
-import accuracy_lib  # noqa: E402
+from tools.wavepath_tools import accuracy_lib  # noqa: E402
 
 DEFAULT_SCENES = ("scenes/cornell_box.gltf", "scenes/failure/small_light_room.gltf",
                   "scenes/failure/glossy_floor.gltf", "scenes/failure/opening_room.gltf")

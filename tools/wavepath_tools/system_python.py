@@ -19,6 +19,10 @@ def need_numpy(tool, packages="python3-numpy"):
     if (os.path.exists(SYSTEM) and os.environ.get("WP_SYSTEM_PYTHON_REEXEC") != "1"
             and os.path.realpath(sys.executable) != os.path.realpath(SYSTEM)):
         os.environ["WP_SYSTEM_PYTHON_REEXEC"] = "1"
+        main = sys.modules["__main__"]
+        # A tool run as a module (python3 -m tools.studies.NAME) re-runs as one.
+        if getattr(main, "__spec__", None) is not None:
+            os.execv(SYSTEM, [SYSTEM, "-m", main.__spec__.name] + sys.argv[1:])
         os.execv(SYSTEM, [SYSTEM] + sys.argv)
     sys.exit("%s: error: numpy is not importable by %s; install Debian's %s"
              % (tool, sys.executable, packages))

@@ -4,7 +4,7 @@ degree 8, fitted for the least largest absolute error by Lawson's iteratively re
 squares on a dense grid (the weights converge to the minimax error's alternation points), in
 double precision; then the fit's largest error in double and, with the coefficients rounded to
 float, the largest error of Horner's scheme evaluated in float. Needs numpy. Run from the
-repository root: python3 tools/gen_atan_poly.py"""
+repository root: python3 tools/generators/gen_atan_poly.py"""
 
 import numpy as np
 

@@ -3,7 +3,7 @@
 300) small one-sided emissive squares of different colours hanging just under a black ceiling,
 facing down; grey Lambertian walls and floor; the camera inside.
 
-    python3 tools/make_many_lights.py OUT.gltf [--lamps 300] [--layout grid|random] [--seed 1]
+    python3 scenes/make_many_lights.py OUT.gltf [--lamps 300] [--layout grid|random] [--seed 1]
 
 Room: x 0 .. 4, y 0 (floor) .. 2.5 (ceiling), z 0 .. 4 metres; the walls, the floor and the
 ceiling face into the room (one-sided, like every material here), so the room is closed from the
@@ -12,7 +12,7 @@ inside. Walls and floor reflect 0.5 (grey), the ceiling 0 (black). The lamps: sq
 colour 0.8 grey, each its own material with a random colour (deterministic in --seed) of peak
 radiance 10 to 30 W/(m^2 sr) times --radiance. Layout `grid` (the default) puts them on a regular
 grid over the ceiling, apart from each other; `random` at uniformly random positions at the same
-height, where some overlap: coincident emitters, which tools/peers_scene.py refuses (the renderers,
+height, where some overlap: coincident emitters, which tools/wavepath_tools/peers_scene.py refuses (the renderers,
 and wavepath's own light and BSDF sampling, resolve them differently; docs/peers.md, notes).
 Every material has KHR_materials_specular specularFactor 0, so wavepath renders it Lambertian, as
 the peers do (no Lambertian copy needed). The camera stands near the wall at z = 4 and looks
@@ -22,13 +22,9 @@ across the room and up at the lamps.
 import argparse
 import colorsys
 import math
-import os
 import random
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
-                                "scenes"))
-from gltf_builder import GltfBuilder  # noqa: E402
+from gltf_builder import GltfBuilder
 
 W, H, D = 4.0, 2.5, 4.0  # room size (x, y, z), metres
 LAMP = 0.06  # lamp side, metres
