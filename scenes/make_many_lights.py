@@ -13,7 +13,7 @@ colour 0.8 grey, each its own material with a random colour (deterministic in --
 radiance 10 to 30 W/(m^2 sr) times --radiance. Layout `grid` (the default) puts them on a regular
 grid over the ceiling, apart from each other; `random` at uniformly random positions at the same
 height, where some overlap: coincident emitters, which tools/wavepath_tools/peers_scene.py refuses (the renderers,
-and wavepath's own light and BSDF sampling, resolve them differently; docs/peers.md, notes).
+and wavepath's own light and BSDF sampling, resolve them differently; docs/peers.md, Coincident emitters).
 Every material has KHR_materials_specular specularFactor 0, so wavepath renders it Lambertian, as
 the peers do (no Lambertian copy needed). The camera stands near the wall at z = 4 and looks
 across the room and up at the lamps.

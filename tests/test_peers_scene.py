@@ -273,7 +273,7 @@ def _mesh(name, material, *triangles):
 
 
 class CoincidentEmitters(unittest.TestCase):
-    """peers_scene.coincident_emitters and load()'s refusal (docs/peers.md, notes: such lamps made
+    """peers_scene.coincident_emitters and load()'s refusal (docs/peers.md, Coincident emitters: such lamps made
     Cycles 3% darker than wavepath and Mitsuba, and wavepath's light and BSDF sampling disagree)."""
 
     MATERIALS = [{"emission": (1.0, 1.0, 1.0)}, {"emission": (0.0, 0.0, 0.0)}]

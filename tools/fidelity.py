@@ -650,11 +650,11 @@ def write_page(a, rows, zero_rows, info):
              "mip-mapped textures, `--mipmaps on`, where Cycles' are at full resolution"), ""]
     other = info.get("other")
     L += ["Machine: %s, %d cores; both render on the CPU. Versions: Blender %s (glTF importer "
-          "%s); wavepath `%s` (%s). This run: %s; %.0f s in all, Cycles' images %d rendered and "
+          "%s); wavepath `%s` (%s). This run: %.0f s in all, Cycles' images %d rendered and "
           "%d from the cache%s."
           % (peers._cpu_name(), os.cpu_count(), a.bpy_version, info["importer_version"],
              os.path.relpath(a.wavepath, REPO) if a.wavepath.startswith(REPO)
-             else a.wavepath, info["wavepath_version"], info["date"], info["total_seconds"],
+             else a.wavepath, info["wavepath_version"], info["total_seconds"],
              info["cycles_rendered"], info["cycles_cached"],
              "" if not other else "; other work took %.0f%% of the machine's CPU time meanwhile "
              "(its busy time in /proc/stat less this tool's processes), which slows every wall "
@@ -924,10 +924,8 @@ def main(argv):
                                                                time.gmtime()),
             "total_seconds": total, "cycles_cached": cached, "other": other,
             "cycles_rendered": len(every) - cached, "importer_version": importer_version,
-            "wavepath_version": "%s, %s; repository at git %s" % (
-                wp_version.splitlines()[0] if wp_version else "?",
-                time.strftime("built %Y-%m-%d %H:%M UTC", time.gmtime(
-                    os.stat(a.wavepath).st_mtime)), rev),
+            "wavepath_version": "%s; repository at git %s" % (
+                wp_version.splitlines()[0] if wp_version else "?", rev),
             "used": {m: docs[m].get("extensionsUsed", []) for m in a.models},
             "required": {m: docs[m].get("extensionsRequired", []) for m in a.models}}
     write_page(a, rows, zero_rows, info)

@@ -3,7 +3,7 @@
 the project's own glTF scenes, converted exactly; error against whole-process time, written as a
 Markdown page with a chart and a table of time-to-target ratios.
 
-    tools/peers.py --scene scenes/cornell_box.gltf --width 128 --height 128 --out docs/peers.md
+    tools/peers.py --scene scenes/cornell_box.gltf --width 512 --height 512 --out docs/peers_512.md
     tools/peers.py --pbr --renderers wavepath,cycles --scene MODEL.glb --env MAP.hdr \
         --out docs/peers_helmet.md
 
@@ -46,7 +46,7 @@ DESCRIPTION = """\
 Converts the scene (tools/wavepath_tools/peers_scene.py: world-space triangle meshes, Lambertian materials,
 emitters, point lights, the first perspective camera; anything else is refused, and so is an
 emitter coplanar with and overlapping another surface, which each renderer resolves its own way:
-docs/peers.md, notes) for each peer.
+docs/peers.md, Coincident emitters) for each peer.
 A glTF material with metallic 0 is not Lambertian: glTF, and wavepath, put a rough specular layer
 (Fresnel 0.04 at normal incidence, 1 at grazing) over the diffuse one, which neither peer's diffuse
 BSDF has. So when a material lacks KHR_materials_specular specularFactor 0, the benchmark renders
@@ -65,8 +65,7 @@ wavepath too: all three render the same purely Lambertian scene.
              wavepath's depth d is Mitsuba's d + 1; but Mitsuba's roulette, like wavepath's,
              decides on the ray leaving the rr_depth-th scattering event: its path.cpp counts
              the event before the test `depth >= rr_depth`, and its docs say rr_depth 1 may end
-             a path after the directly visible surface. Until 2026-11-25 this mapped rr_depth + 1,
-             which gave Mitsuba one more bounce before roulette than wavepath).
+             a path after the directly visible surface).
   Cycles     Mesh objects with a material Diffuse BSDF (roughness 0: Lambert) + Emission
              (colour = the radiance, strength 1), and, for a material that is not double-sided,
              a Mix Shader that turns back faces into a Transparent BSDF: wavepath culls back
@@ -457,8 +456,9 @@ def parse_args(argv):
     p.add_argument("--work", default=os.path.join(REPO, "build", "peers-work"),
                    help="scratch folder: converted scene, images, the cached reference")
     p.add_argument("--mitsuba-variant", default="llvm_ad_rgb")
-    p.add_argument("--out", default=os.path.join(REPO, "docs", "peers.md"),
-                   help="the Markdown page; the chart is written next to it")
+    p.add_argument("--out", default=None,
+                   help="the Markdown page; the chart is written next to it (default: peers.md "
+                        "in the --work folder)")
     p.add_argument("--quick", action="store_true",
                    help="a smoke run: 64 x 64, spp 4,16, reference 256 spp")
     p.add_argument("--repeat", type=int, default=1,
@@ -495,6 +495,8 @@ def parse_args(argv):
                         "--ref-spp / N samples with different seeds; their spread gives its "
                         "variance image (default %(default)s)")
     a = p.parse_args(argv)
+    if a.out is None:
+        a.out = os.path.join(a.work, "peers.md")
     if a.quick:
         a.width, a.height, a.spp, a.ref_spp = 64, 64, "4,16", 256
     a.spp = [int(s) for s in a.spp.split(",")]
