@@ -1,5 +1,5 @@
 // CPU reference traversal of the wide layout (BvhNode8 + TriBlock4). The arithmetic is that of
-// traverse_common.h; the order below is the specification kernels/traverse8.h copies:
+// traverse_common.h; the order below is the specification kernels/traversal/traverse8.h copies:
 //
 //   1. At a node, the slab test of all 8 lanes against tmax_current (the current closest t; the
 //      ray's tmax before any hit).
@@ -16,7 +16,7 @@
 //
 // An any-hit answer does not depend on this order: until its first hit the closest t stays the
 // ray's tmax, so every box it enters is entered in whatever order the nodes come, and nothing is
-// skipped; kernels/traverse8.h visits the children in lane order there, unsorted.
+// skipped; kernels/traversal/traverse8.h visits the children in lane order there, unsorted.
 //
 // child == 0 is an unused slot (node 0 is the root, nobody's child) and is never visited. Its box
 // (lo = hi = +INFINITY) keeps out every ray with a finite tmax, but a ray with tmax = +INFINITY

@@ -1,8 +1,9 @@
 // Internal to bvh/: the arithmetic both reference traversals (bvh_traverse.cpp: binary,
-// bvh_traverse_wide.cpp: 8-wide) share. It is the oracle the OpenCL kernels (kernels/traverse.h,
-// kernels/traverse8.h) are tested against, so it is the specification and the kernels copy it
-// operation for operation (all float, no fused multiply-adds: wp_bvh is built with
-// -ffp-contract=off, and OpenCL kernels need FP_CONTRACT OFF to match bit for bit):
+// bvh_traverse_wide.cpp: 8-wide) share. It is the oracle the OpenCL kernels
+// (kernels/traversal/traverse.h, kernels/traversal/traverse8.h) are tested against, so it is the
+// specification and the kernels copy it operation for operation (all float, no fused multiply-adds:
+// wp_bvh is built with -ffp-contract=off, and OpenCL kernels need FP_CONTRACT OFF to match bit for
+// bit):
 //
 //   slab test   inv_d[k] = 1 / (|d[k]| > 1e-20 ? d[k] : copysign(1e-20, d[k]))
 //               t0 = (lo - o) * inv_d, t1 = (hi - o) * inv_d per axis
@@ -16,10 +17,10 @@
 //
 // Why d and the index: the closest hit must not depend on the order the walk visits nodes in, so
 // that walks of different orders (nearest child first per ray, a packet's order for eight rays:
-// kernels/traverse8_packet.h) give every ray the same answer. Two things would make it depend:
-// (1) two triangles at the same distance (a ray through an edge both share hits both), where
-// "the first found" wins; the lower scene triangle index wins instead. (2) Rounding: a box whose
-// computed tnear exceeds the computed t of a triangle inside it by an ulp is culled by a hit
+// kernels/traversal/traverse8_packet.h) give every ray the same answer. Two things would make it
+// depend: (1) two triangles at the same distance (a ray through an edge both share hits both),
+// where "the first found" wins; the lower scene triangle index wins instead. (2) Rounding: a box
+// whose computed tnear exceeds the computed t of a triangle inside it by an ulp is culled by a hit
 // between the two in one order and not in another. With d >= tleaf no box is ever culled by a hit
 // its own content beats: boxes nest (bvh_check: every child box lies inside its parent's) and the
 // slab distance (plane - o) * inv_d is monotone in the plane for a given ray, so every ancestor's

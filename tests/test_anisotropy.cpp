@@ -1,4 +1,4 @@
-// sampling tier: anisotropic GGX (kernels/ggx_aniso.h, KHR_materials_anisotropy) on the OpenCL
+// sampling tier: anisotropic GGX (kernels/bsdf/ggx_aniso.h, KHR_materials_anisotropy) on the OpenCL
 // device, against its own densities and a float64 model written here from the formulas of the
 // header's comment (not its code).
 //
@@ -16,7 +16,7 @@
 //   normals' density) over the hemisphere.
 // - Float64 references (AnisotropicGgx.MatchesFloat64Model): the device's D, Lambda, G1,
 //   visibility and pdf at random points, relative tolerances from float32 rounding (below).
-// - Isotropic limit (AnisotropicGgx.ReducesToIsotropic): ax == ay against sampling.h's ggx_d,
+// - Isotropic limit (AnisotropicGgx.ReducesToIsotropic): ax == ay against sampling/warps.h's ggx_d,
 //   ggx_g1, ggx_visibility, ggx_reflection_pdf and sample_ggx_visible_normal.
 // - Robustness (AnisotropicGgx.FiniteEverywhere): no NaN or Inf over a sweep of alphas (0, under
 //   the floor, 1e-3 .. 1), views to exactly grazing, and random numbers at their ends.
@@ -379,7 +379,7 @@ TEST(AnisotropicGgx, Normalisation) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Pointwise: the device against the float64 model, and against sampling.h's isotropic GGX.
+// Pointwise: the device against the float64 model, and against sampling/warps.h's isotropic GGX.
 
 // Random unit directions (a fixed stream) with |z| spread over [1e-5, 1] (half log-uniform, half
 // uniform in z), so that grazing directions are common; z < 0 with probability `below`.
@@ -474,8 +474,8 @@ TEST(AnisotropicGgx, MatchesFloat64Model) {
   EXPECT_GT(pdfs, kPoints / 4) << "too few points where the pdf is compared";
 }
 
-// ax == ay: the isotropic functions of sampling.h, up to both sides' rounding. Their bounds (in
-// u, counted as above): ggx_d 16.5u (a^2 cos^2 3u, + sin^2 4u, pi k^2 10.5u, quotient 16.5u);
+// ax == ay: the isotropic functions of sampling/warps.h, up to both sides' rounding. Their bounds
+// (in u, counted as above): ggx_d 16.5u (a^2 cos^2 3u, + sin^2 4u, pi k^2 10.5u, quotient 16.5u);
 // ggx_g1 15u (the radicand a^2 + (1 - a^2) c^2 within 6u: its terms are positive up to 1 - a^2's
 // rounding, 1u of the radicand; sqrt 9u; c + sqrt 10u; quotient 15u); ggx_visibility 16u
 // likewise; ggx_reflection_pdf 37.5u (g1 15u, d 16.5u, x 1u, / 4c 5u). Their formulas assume
@@ -510,7 +510,7 @@ TEST(AnisotropicGgx, ReducesToIsotropic) {
     same_h += dh == 0.0;
   }
   std::printf(
-      "ax == ay vs sampling.h, worst relative differences in u: D %.1f (%zu of %zu bit for "
+      "ax == ay vs sampling/warps.h, worst relative differences in u: D %.1f (%zu of %zu bit for "
       "bit), G1 %.1f, V %.1f, pdf %.1f (%zu); sample %.1e (%zu of %zu bit for bit)\n",
       worst[0] / kU, same_d, compared_d, worst[1] / kU, worst[2] / kU, worst[3] / kU, pdfs,
       worst[4], same_h, kPoints);

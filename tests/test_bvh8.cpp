@@ -452,9 +452,9 @@ bool same_hit(const Hit& a, const Hit& b) {
 
 // The walk (nearest child first, culling by the closest hit so far) gives every ray the hit the
 // definition gives, in either order of the leaves: so any order does (what packets of rays rely
-// on, kernels/traverse8_packet.h). Rays aimed at the vertices and edge midpoints of a grid, flat
-// (its leaf boxes flat too, so that a hit's t and its leaf's tnear are two roundings of one
-// distance) and curved, where several triangles tie; random rays besides. Both kinds of case
+// on, kernels/traversal/traverse8_packet.h). Rays aimed at the vertices and edge midpoints of a
+// grid, flat (its leaf boxes flat too, so that a hit's t and its leaf's tnear are two roundings of
+// one distance) and curved, where several triangles tie; random rays besides. Both kinds of case
 // occur and are counted: ties, and hits whose leaf's tnear exceeds the triangle's own t, where
 // the distance is that tnear, checked to lie within 4 ulps (tnear's three roundings and one for
 // the double-precision distance) of the exact distance computed in double.

@@ -66,8 +66,8 @@ double texel_solid_angle(const wp::EnvironmentMap& env, int y) {
   return 2.0 * kPi / env.width * (std::cos(kPi * y / h) - std::cos(kPi * (y + 1) / h));
 }
 
-// Host reference of the bilinear lookup (kernels/environment.h), written from the convention in
-// float64: texel centres at ((x + 0.5) / W, (y + 0.5) / H), columns wrapped, rows clamped.
+// Host reference of the bilinear lookup (kernels/lights/environment.h), written from the convention
+// in float64: texel centres at ((x + 0.5) / W, (y + 0.5) / H), columns wrapped, rows clamped.
 glm::dvec3 bilinear_at(const wp::EnvironmentMap& env, double u, double v) {
   const int w = env.width, h = env.height;
   const double fx = u * w - 0.5, fy = v * h - 0.5;

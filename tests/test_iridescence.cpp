@@ -1,4 +1,4 @@
-// KHR_materials_iridescence's thin-film Fresnel term (kernels/iridescence.h) on the device,
+// KHR_materials_iridescence's thin-film Fresnel term (kernels/bsdf/iridescence.h) on the device,
 // against a float64 reference computed here from physics, not from the model: the exact spectral
 // reflectance of the film and its limits.
 //

@@ -66,7 +66,7 @@ TEST(KernelSources, PathStateIsReachedOnlyThroughItsAccessors) {
   int files = 0;
   for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
     const std::string name = f.name;
-    if (name == "path_state.h") continue;  // the accessors themselves
+    if (name == "integrator/path_state.h") continue;  // the accessors themselves
     ++files;
     std::istringstream lines(f.text);
     int number = 0;
@@ -98,7 +98,7 @@ std::string without_comments(const std::string& text) {
 // No kernel calls OpenCL's transcendental builtins: PoCL compiles them into out-of-line library
 // routines, which took 12-20% of renders where they were on the hot path (docs/performance.md,
 // "Environment lookups without library calls", "Sheen without library calls");
-// kernels/elementary.h has inlined versions with stated bounds. sqrt, fma, floor and the like,
+// kernels/util/elementary.h has inlined versions with stated bounds. sqrt, fma, floor and the like,
 // single instructions, are not in the list.
 TEST(KernelSources, NoTranscendentalLibraryCalls) {
   const std::regex call(

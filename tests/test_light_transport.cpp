@@ -228,7 +228,7 @@ std::shared_ptr<const wp::EnvironmentMap> test_sky() {
 }
 
 // A scene whose materials have no specular layer (metallic 0, KHR_materials_specular factor 0)
-// builds the Lambert-only BSDF (WP_FEATURE_GLOSSY 0, kernels/bsdf.h). It must render what the
+// builds the Lambert-only BSDF (WP_FEATURE_GLOSSY 0, kernels/bsdf/bsdf.h). It must render what the
 // general BSDF renders with the same random numbers: the values agree up to float rounding (1e-4
 // relative; a path can take another turn where a roulette or lobe decision sits within rounding
 // of its threshold, about once per 10^6 decisions, so up to 0.5% of pixels may differ more), and

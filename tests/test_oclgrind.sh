@@ -215,7 +215,7 @@ canary() {
   ran=$((ran + 1))
   if ! grep -q 'qs.counters\[q + WP_COUNTER_COUNT\]' "$dir/queues.h"; then
     failures=$((failures + 1))
-    echo "FAIL canary: could not plant the out-of-bounds read (queue_get in kernels/queues.h changed;"
+    echo "FAIL canary: could not plant the out-of-bounds read (queue_get in kernels/integrator/queues.h changed;"
     echo "     update the sed pattern in $0)"
     return
   fi

@@ -201,7 +201,7 @@ TEST(PackedSize, ReleasingPackPacksTheSameBytesAndFreesTheHostArrays) {
   }
 }
 
-// The optional per-vertex arrays a program reads follow its features (kernels/material.h and
+// The optional per-vertex arrays a program reads follow its features (kernels/geom/material.h and
 // alpha.h read them only under these flags): texture coordinates for textures, tangents for normal
 // maps, colours for COLOR_0 and for alpha; none for a plain scene; all with every feature.
 TEST(PackedSize, OnlyTheVertexArraysTheProgramReadsArePacked) {

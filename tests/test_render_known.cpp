@@ -41,7 +41,7 @@ class RenderKnown : public wp::test::DeviceTest {};
 constexpr int kWidth = 64, kHeight = 48, kSpp = 16;
 
 // The direction of the camera ray through image point (x, y) in pixels (y down), computed as the
-// kernel does (kernels/camera.h) but in double precision.
+// kernel does (kernels/camera/camera.h) but in double precision.
 dvec3 camera_dir(const wp::dev::Camera& c, double x, double y) {
   const double nx = 2.0 * x / kWidth - 1.0, ny = 1.0 - 2.0 * y / kHeight;
   const dvec3 f(c.forward.x, c.forward.y, c.forward.z), r(c.right.x, c.right.y, c.right.z),
@@ -596,8 +596,8 @@ void expect_deterministic(wp::ClRuntime& runtime, const std::vector<wp::Sampler>
     EXPECT_GT(sum, 0.0);
     // ... and with the cache hints off (prefetch false; on PoCL they are on by default), and with
     // each shadow and closest-hit ray traced on its own (on PoCL's CPU devices they go eight to a
-    // work-item by default, kernels/traverse8_packet.h, and the wave and group sizes change which
-    // rays share a packet).
+    // work-item by default, kernels/traversal/traverse8_packet.h, and the wave and group sizes
+    // change which rays share a packet).
     for (const auto& [wave, local, prefetch, packets] : cases) {
       st.wave_size = wave;
       st.local_size = local;

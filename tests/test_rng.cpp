@@ -1,5 +1,5 @@
-// The sample patterns of kernels/rng.h, drawn on the OpenCL device by tests/kernels/rng_kernels.cl
-// and checked on the host:
+// The sample patterns of kernels/sampling/rng.h, drawn on the OpenCL device by
+// tests/kernels/rng_kernels.cl and checked on the host:
 // - uniformity: over many pixels, the numbers each dimension group draws at a given sample index
 //   and bounce are uniform on [0,1) or [0,1)^2 (chi-square), for both patterns;
 // - stratification (Sobol): every aligned block of 2^k samples of one pixel puts exactly one point
@@ -41,7 +41,7 @@ struct Group {
   std::uint32_t dim;
   bool pair;
 };
-// kernels/rng.h: WP_DIM_PIXEL_X, _LIGHT_PICK, _LIGHT_U, _BSDF_LOBE, _BSDF_U, _ROULETTE.
+// kernels/sampling/rng.h: WP_DIM_PIXEL_X, _LIGHT_PICK, _LIGHT_U, _BSDF_LOBE, _BSDF_U, _ROULETTE.
 const Group kGroups[] = {{"pixel", 0, true},      {"light_pick", 2, false}, {"light_uv", 3, true},
                          {"bsdf_lobe", 5, false}, {"bsdf_uv", 6, true},     {"roulette", 8, false}};
 

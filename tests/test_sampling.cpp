@@ -154,7 +154,7 @@ void tally(Draw& d) {
 class Device {
  public:
   // The program with every feature, or the Lambert-only build of a scene without a specular
-  // layer (WP_FEATURE_GLOSSY 0: kernels/bsdf.h). Each is built on first use.
+  // layer (WP_FEATURE_GLOSSY 0: kernels/bsdf/bsdf.h). Each is built on first use.
   static Device& get(bool lambert_build) {
     if (lambert_build) {
       static Device lambert("-D WP_FEATURE_GLOSSY=0 -D WP_FEATURE_TRANSMISSION=0");
@@ -495,14 +495,14 @@ Config with_samples(Config c, std::uint32_t samples) {
 
 const float4 kWhite = {1, 1, 1, 0}, kSaturated = {0.9f, 0.1f, 0.02f, 0};
 
-// The eight-lane twins of common.h, elementary.h and sampling.h (tests/kernels/lanes_kernels.cl)
-// against their scalar originals on the same inputs, bit for bit, as the packet kernels need
-// (integrator/shade_packet.h: the same images with and without packets): vectors whose squared
-// length is zero, subnormal, just inside and outside (1e-30, 1e30) (where length3x8 and
-// normalize3x8 hand the lane to the builtin) or huge, mixed in one packet with ordinary ones, and
-// signed zeros; fractions of a turn and unit-square points at their boundaries. NaN results (the
-// zero vector's normal) must be NaN on both sides. Built with and without WP_PREFETCH (lane_bits8's
-// x86 builtin or its generic form).
+// The eight-lane twins of common.h, elementary.h and sampling/warps.h
+// (tests/kernels/lanes_kernels.cl) against their scalar originals on the same inputs, bit for bit,
+// as the packet kernels need (integrator/shade_packet.h: the same images with and without packets):
+// vectors whose squared length is zero, subnormal, just inside and outside (1e-30, 1e30) (where
+// length3x8 and normalize3x8 hand the lane to the builtin) or huge, mixed in one packet with
+// ordinary ones, and signed zeros; fractions of a turn and unit-square points at their boundaries.
+// NaN results (the zero vector's normal) must be NaN on both sides. Built with and without
+// WP_PREFETCH (lane_bits8's x86 builtin or its generic form).
 TEST(LaneTwins, MatchTheirScalarFunctions) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f), exponent(-25.0f, 25.0f);
@@ -577,13 +577,14 @@ TEST(LaneTwins, MatchTheirScalarFunctions) {
   }
 }
 
-// cos_sin_turn (kernels/sampling.h), the (cos, sin) of 2 pi u that the GGX visible-normal samplers
-// and the uniform sphere use instead of the library's cos and sin: against double precision at u
-// (the float itself), on a dense grid and at every quarter turn's boundary and its neighbours. The
-// bound: t = (4u - q) pi/2 with 4u - q exact and |t| <= pi/4 rounds by at most 2^-24 pi/4 and
-// pi/2's own rounding adds 2^-25 pi/4 (both < 5e-8 in the angle); the Taylor remainders are below
-// 2e-9; Horner's five float steps round by at most 5 x 2^-24 (3e-7) of values <= 1: 4e-7 in all.
-// Quarter turns are exact (cos 2 pi u is exactly 1, 0, -1, 0 at u = 0, 1/4, 1/2, 3/4).
+// cos_sin_turn (kernels/sampling/warps.h), the (cos, sin) of 2 pi u that the GGX visible-normal
+// samplers and the uniform sphere use instead of the library's cos and sin: against double
+// precision at u (the float itself), on a dense grid and at every quarter turn's boundary and its
+// neighbours. The bound: t = (4u - q) pi/2 with 4u - q exact and |t| <= pi/4 rounds by at most
+// 2^-24 pi/4 and pi/2's own rounding adds 2^-25 pi/4 (both < 5e-8 in the angle); the Taylor
+// remainders are below 2e-9; Horner's five float steps round by at most 5 x 2^-24 (3e-7) of values
+// <= 1: 4e-7 in all. Quarter turns are exact (cos 2 pi u is exactly 1, 0, -1, 0 at u = 0, 1/4, 1/2,
+// 3/4).
 TEST(Sampling, CosSinTurn) {
   wp::test::KernelHarness h({"trig_kernels.cl"});
   std::vector<float> u;
@@ -619,16 +620,16 @@ TEST(Sampling, CosSinTurn) {
   }
 }
 
-// atan2_poly (kernels/elementary.h), the atan2 of the environment map's lookup: against double
+// atan2_poly (kernels/util/elementary.h), the atan2 of the environment map's lookup: against double
 // precision atan2 of the same floats, at 2^20 angles around the circle (each at radii from 1e-30
 // to 1e30, where the quotient min/max must not lose its precision), densely near the octant
 // boundaries |x| = |y| where the reflection pi/2 - r takes over, and on the axes with both signed
 // zeros. The bound, summed over the steps: the quotient a = min/max, correctly rounded on PoCL
 // (Elementary's comment below says more), rounds by at most 2^-24 a
 // (6e-8 in the angle, as atan' <= 1); the polynomial with float coefficients, evaluated by Horner
-// in float, is within 1.1e-7 of atan on [0, 1] (tools/generators/gen_atan_poly.py, at 4 million points);
-// pi/2 - r and pi - r round by at most half an ulp of results below 2 and 4 (6e-8, 1.2e-7) with
-// the float constants pi/2 and pi off by 4.4e-8 and 8.8e-8: 4.8e-7 in all. Exact where the
+// in float, is within 1.1e-7 of atan on [0, 1] (tools/generators/gen_atan_poly.py, at 4 million
+// points); pi/2 - r and pi - r round by at most half an ulp of results below 2 and 4 (6e-8, 1.2e-7)
+// with the float constants pi/2 and pi off by 4.4e-8 and 8.8e-8: 4.8e-7 in all. Exact where the
 // octant's angle is: 0, +-pi/2 and +-pi on the axes (float pi/2 and pi, as the library gives),
 // with atan2's signs of zero.
 TEST(Sampling, Atan2Poly) {
@@ -675,7 +676,7 @@ TEST(Sampling, Atan2Poly) {
   }
 }
 
-// The other functions of kernels/elementary.h against double precision: each at 2^20 or more
+// The other functions of kernels/util/elementary.h against double precision: each at 2^20 or more
 // arguments, its error in u = 2^-24 relative to the exact value (half an ulp), against the bound
 // that header states, derived here from its steps (a correctly rounded + - * / rounds by at most u
 // relative; Taylor and series remainders as that header gives them), and its special values. The
@@ -867,11 +868,11 @@ TEST_F(Elementary, Log2AndCos) {
   EXPECT_EQ(run(6, {{{0.0f, 0}}})[0], 1.0f);
 }
 
-// The thin lens's disc sampler (kernels/camera.h): uniform on the unit disc, pdf 1/pi. Binned into
-// 16 rings of equal area (r^2 in steps of 1/16) x 32 sectors, each of probability 1/512, from 2^20
-// independent points of the square (a host Mersenne Twister, so the counts are multinomial and
-// Pearson's statistic chi-square with 511 degrees of freedom); no point may fall outside the disc
-// beyond float rounding (|p| <= 1 + 1e-6).
+// The thin lens's disc sampler (kernels/camera/camera.h): uniform on the unit disc, pdf 1/pi.
+// Binned into 16 rings of equal area (r^2 in steps of 1/16) x 32 sectors, each of probability
+// 1/512, from 2^20 independent points of the square (a host Mersenne Twister, so the counts are
+// multinomial and Pearson's statistic chi-square with 511 degrees of freedom); no point may fall
+// outside the disc beyond float rounding (|p| <= 1 + 1e-6).
 TEST(Sampling, ConcentricDisk) {
   wp::test::KernelHarness h({"trig_kernels.cl"});
   constexpr std::uint32_t kCount = 1u << 20;
@@ -1019,7 +1020,7 @@ TEST(Sampling, DielectricTransmissionExhaustive) {
   for (const Config& c : dielectric_configs()) check_bsdf(c);
 }
 
-// The layered material extensions (kernels/bsdf.h): every configuration is the whole BSDF, its
+// The layered material extensions (kernels/bsdf/bsdf.h): every configuration is the whole BSDF, its
 // samples against bsdf_eval's pdf as above, with fewer samples than kSamples to keep the run time
 // down (the extensions' evaluation costs up to 3x the plain BSDF's; iridescence most). Power: a
 // sampler that puts a fraction e of its samples where the pdf does not (a lobe's probability or

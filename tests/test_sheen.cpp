@@ -1,7 +1,7 @@
-// The KHR_materials_sheen lobe (kernels/sheen.h) on the device against this file's float64
+// The KHR_materials_sheen lobe (kernels/bsdf/sheen.h) on the device against this file's float64
 // evaluation of the extension's formulas (sheen.h's header; written from the formulas, not from
-// sheen.h's code), and the albedo table (kernels/sheen_table.h, tools/generators/gen_sheen_table.py) against
-// an independent quadrature.
+// sheen.h's code), and the albedo table (kernels/bsdf/sheen_table.h,
+// tools/generators/gen_sheen_table.py) against an independent quadrature.
 //
 // The reference albedo integrates over the microfacet normal h, where the generator integrates over
 // wi: with d omega_i = 4 (wo.h) d omega_h and V cos_i = G / (4 mu),
@@ -21,8 +21,8 @@
 //   the float nearest the generator's value);
 // - sheen_eval, sheen_d, sheen_lambda: a first-order bound of float32 rounding computed per sample
 //   from each operation's worst case in OpenCL 1.2's full profile (+ - * correctly rounded, x/y
-//   2.5 ulp, exp 3, log 3, log1p 2 ulp, which bound kernels/elementary.h's exp_poly, log_poly and
-//   log1p_poly too, and elementary.h's powr_poly, within (3 + 5 |c ln x|) u; 1 ulp <= 2 u
+//   2.5 ulp, exp 3, log 3, log1p 2 ulp, which bound kernels/util/elementary.h's exp_poly, log_poly
+//   and log1p_poly too, and elementary.h's powr_poly, within (3 + 5 |c ln x|) u; 1 ulp <= 2 u
 //   relative, u = 2^-24) propagated
 //   to first order through the formulas with this sample's magnitudes (l_error, lambda_error,
 //   d_error and the tests' own terms spell out each one), times 1.1 for the second-order terms
@@ -272,10 +272,11 @@ struct Layout {
   }
 };
 
-// Device rounding of sheen_albedo's lookup: cbrt_poly ((3 + 2 |ln mu|) u, kernels/elementary.h)
-// and the scaling put x off by < (4 + 2 |ln mu|) u x, x = 31 mu^(1/3): at most 6 e^(-1/3) 31 u
-// (at mu = 1/e) <= 160 u cell widths, sqrt and its scaling y by < 10 u (sqrt(r) - s0) 31 / (1 - s0)
-// < 250 u; times slopes below 0.5 per cell and the three mixes' few u E: < 250 u ~ 1.5e-5.
+// Device rounding of sheen_albedo's lookup: cbrt_poly ((3 + 2 |ln mu|) u,
+// kernels/util/elementary.h) and the scaling put x off by < (4 + 2 |ln mu|) u x, x = 31 mu^(1/3):
+// at most 6 e^(-1/3) 31 u (at mu = 1/e) <= 160 u cell widths, sqrt and its scaling y by < 10 u
+// (sqrt(r) - s0) 31 / (1 - s0) < 250 u; times slopes below 0.5 per cell and the three mixes' few u
+// E: < 250 u ~ 1.5e-5.
 constexpr double kLookupRounding = 1.5e-5;
 
 class Sheen : public ::testing::Test {

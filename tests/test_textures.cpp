@@ -1,9 +1,9 @@
-// kernel tier: texture sampling (kernels/textures.h), alpha (kernels/alpha.h) and material
-// resolution (kernels/material.h) on the OpenCL device, against host references written here from
-// the glTF 2.0 specification (its samplers follow OpenGL: texel centres at (i + 0.5) / size, wrap
-// modes on texel indices, NEAREST or bilinear LINEAR magnification) and the sRGB standard, over
-// scenes packed by host/device/device_scene.cpp exactly as renders are. The references compute in
-// double.
+// kernel tier: texture sampling (kernels/texture/textures.h), alpha (kernels/traversal/alpha.h) and
+// material resolution (kernels/geom/material.h) on the OpenCL device, against host references
+// written here from the glTF 2.0 specification (its samplers follow OpenGL: texel centres at (i +
+// 0.5) / size, wrap modes on texel indices, NEAREST or bilinear LINEAR magnification) and the sRGB
+// standard, over scenes packed by host/device/device_scene.cpp exactly as renders are. The
+// references compute in double.
 //
 // Tolerances are float rounding bounds, derived where they are used (texture_bound()). Bilinear
 // filtering is 1-Lipschitz in the texel-space position per axis (texel values lie in [0, 1]), so
@@ -575,7 +575,7 @@ TEST(Material, NormalMapKeepsReflectionAboveSurface) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Mip chains (host/scene/mipmap.cpp) and lookups through them (kernels/textures.h)
+// Mip chains (host/scene/mipmap.cpp) and lookups through them (kernels/texture/textures.h)
 
 // Level k of `image` as an Image, from mip_chain's output (level 0: the image).
 wp::Image mip_image(const wp::Image& image, const std::vector<std::uint8_t>& chain, int level) {
@@ -775,16 +775,16 @@ TEST(TextureSample, LevelsMatchTrilinearReference) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Ray cones (kernels/ray_cone.h)
+// Ray cones (kernels/texture/ray_cone.h)
 
-// kernels/ray_cone.h's WP_CONE_SCALE: cones are an eighth of a sample's footprint.
+// kernels/texture/ray_cone.h's WP_CONE_SCALE: cones are an eighth of a sample's footprint.
 constexpr double kConeScale = 0.125;
 
 // The level a camera ray's cone picks on a plane at a known distance and angle, against the
 // analytic footprint: a pinhole's cone spreads by an eighth of the pixel's angle, g = 1/8 x
 // 2 tan(yfov / 2) / height, so at distance t along the ray it is g t across, the minor axis of its
 // footprint on a plane the ray meets at any angle (the major axis, g t / cos, does not count:
-// kernels/ray_cone.h); a texture of W x H texels spread over the plane with texel density
+// kernels/texture/ray_cone.h); a texture of W x H texels spread over the plane with texel density
 // sqrt(W H |det T| A_uv / A_world) per unit length sees that footprint as log2 of (its length x
 // the density) texels: lambda. An orthographic camera's cone is an eighth of the pixel's height,
 // 1/8 x 2 ymag / height, at any distance. Checked for several pixels of tilted views (from

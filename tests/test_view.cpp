@@ -1,5 +1,5 @@
 // The view from the command line (host/scene/view.h): cameras placed by --look-from/--look-at and
-// --orbit, --fov, and the thin lens (--aperture, kernels/camera.h).
+// --orbit, --fov, and the thin lens (--aperture, kernels/camera/camera.h).
 //
 // Known pixels: the expected image positions come from GLM's own view and projection matrices
 // (glm::lookAt, glm::perspective), not from wavepath's camera code. The scenes are black but for

@@ -129,7 +129,7 @@ def with_width(options, width):
 
 def variants(args, tmp):
     """[{label, options, scenes}]: identical option sets merged, with the scenes sharing each."""
-    all_options = "-cl-std=CL1.2 -D WP_BVH_WIDTH=8"  # kernels/features.h: undefined = all on
+    all_options = "-cl-std=CL1.2 -D WP_BVH_WIDTH=8"  # kernels/util/features.h: undefined = all on
     # A two-level BVH (instanced scenes) is the scene's structure, not a feature: its own variant.
     found = [("all", all_options, "all features"),
              ("all instanced", all_options + " -D WP_BVH_INSTANCES=1", "all features instances")]

@@ -1090,7 +1090,7 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "dielectrics with the exact Fresnel equations (IOR 1.5, the importer's \"Specular IOR "
          "Level\" 0.5) and scales the diffuse base by the specular layer's albedo, where glTF "
          "(and wavepath) mix diffuse and specular with Schlick's Fresnel at the half-vector "
-         "(`kernels/bsdf.h`); its metals use the F82-tint model, whose correction to Schlick's "
+         "(`kernels/bsdf/bsdf.h`); its metals use the F82-tint model, whose correction to Schlick's "
          "Fresnel is proportional to one minus the tint, so with the importer's white Specular "
          "Tint they reflect as glTF's (Schlick, base colour as F0); the "
          "tangent frames of the normal map come from different tangent generators (Blender's "

@@ -29,7 +29,7 @@ import tempfile
 
 from wavepath_tools import peers_scene  # noqa: E402
 
-# The material extensions that are kernel features of their own (kernels/features.h).
+# The material extensions that are kernel features of their own (kernels/util/features.h).
 LAYERED = ("KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen",
            "KHR_materials_anisotropy", "KHR_materials_iridescence",
            "KHR_materials_diffuse_transmission", "KHR_materials_dispersion")

@@ -105,9 +105,9 @@ dev::uint wrap_bits(Wrap w) {
                                    : WP_WRAP_MIRROR;
 }
 
-// The texture's term of its mip level (TextureRef.meta.w, kernels/ray_cone.h): 1/2 log2 of the
-// texels its coordinates' unit square covers, the image's width x height times the area scale of
-// the transform; -INFINITY (level 0 always) without a chain.
+// The texture's term of its mip level (TextureRef.meta.w, kernels/texture/ray_cone.h): 1/2 log2 of
+// the texels its coordinates' unit square covers, the image's width x height times the area scale
+// of the transform; -INFINITY (level 0 always) without a chain.
 float lod_term(const TextureRef& t, const dev::TextureImage& image) {
   const double det = double(t.row_u.x) * t.row_v.y - double(t.row_u.y) * t.row_v.x;
   if (!t.mipmaps || image.levels < 2 || !(std::fabs(det) > 0.0)) return -INFINITY;

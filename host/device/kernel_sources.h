@@ -1,5 +1,5 @@
-// OpenCL C sources, embedded into the binary at build time (kernels/embed_sources.cmake), and the
-// include expansion that turns a kernel file into one self-contained program source.
+// OpenCL C sources, embedded into the binary at build time (host/device/embed_sources.cmake), and
+// the include expansion that turns a kernel file into one self-contained program source.
 #pragma once
 
 #include <string>

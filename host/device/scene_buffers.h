@@ -1,5 +1,5 @@
 // The packed scene (device_scene.h) on a device, as the kernels' WP_SCENE_PARAMS take it
-// (kernels/scene.h): WP_SCENE_BUFFERS buffer arguments, then the SceneDesc.
+// (kernels/geom/scene.h): WP_SCENE_BUFFERS buffer arguments, then the SceneDesc.
 #pragma once
 
 #include <array>

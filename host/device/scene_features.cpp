@@ -67,7 +67,7 @@ SceneFeatures SceneFeatures::of(const Scene& scene, bool has_environment_map) {
     return x.dispersion > 0.0f && x.thickness > 0.0f && x.transmission > 0.0f;
   });
   // Without a specular layer (glTF's default metallic is 1, its default specular factor 1), the
-  // BSDF is Lambert's alone (kernels/bsdf.h). Unlit materials scatter nothing.
+  // BSDF is Lambert's alone (kernels/bsdf/bsdf.h). Unlit materials scatter nothing.
   f.glossy = f.transmission || f.specular || f.clearcoat || f.sheen || f.anisotropy ||
              f.iridescence || f.diffuse_transmission || any(m, [](const Material& x) {
                return !x.unlit && (x.metallic > 0.0f || x.specular > 0.0f);

@@ -1,5 +1,5 @@
 // Which optional kernel features a scene uses. The program is built with one -D WP_FEATURE_X=0|1
-// per feature (kernels/features.h), so absent features cost no code, registers or branches.
+// per feature (kernels/util/features.h), so absent features cost no code, registers or branches.
 #pragma once
 
 #include <string>
@@ -18,13 +18,13 @@ struct SceneFeatures {
   bool vertex_colors = true;
   bool textures = true;
   // A texture whose sampler allows mip-maps: textures are minified through ray cones
-  // (kernels/ray_cone.h; emission and alpha excepted); off with --mipmaps off.
+  // (kernels/texture/ray_cone.h; emission and alpha excepted); off with --mipmaps off.
   bool texture_lod = true;
   bool normal_maps = true;
   bool alpha = true;
   bool unlit = true;
   // A scattering material with metallic > 0, specular > 0, transmission or one of the layered
-  // extensions below (they need the full BSDF, kernels/bsdf.h).
+  // extensions below (they need the full BSDF, kernels/bsdf/bsdf.h).
   bool glossy = true;
   bool transmission = true;
   bool volume = true;
@@ -44,10 +44,10 @@ struct SceneFeatures {
 
   static SceneFeatures all() { return {}; }
 
-  // Which per-vertex arrays beyond positions and normals the program reads (kernels/material.h,
-  // alpha.h): tangents for a tangent frame; texture coordinates for textures and wherever the
-  // layered BSDF's texture_point runs; colours for COLOR_0 and for alpha (its alpha channel). An
-  // array the program cannot read is packed empty.
+  // Which per-vertex arrays beyond positions and normals the program reads
+  // (kernels/geom/material.h, alpha.h): tangents for a tangent frame; texture coordinates for
+  // textures and wherever the layered BSDF's texture_point runs; colours for COLOR_0 and for alpha
+  // (its alpha channel). An array the program cannot read is packed empty.
   bool reads_tangents() const { return normal_maps || anisotropy || clearcoat; }
   bool reads_uvs() const {
     return textures || normal_maps || texture_lod || specular || clearcoat || sheen || anisotropy ||

@@ -10,7 +10,8 @@ namespace wp {
 
 namespace {
 
-// Texel index i (any integer) wrapped into [0, n) as the sampler wraps (kernels/textures.h).
+// Texel index i (any integer) wrapped into [0, n) as the sampler wraps
+// (kernels/texture/textures.h).
 int wrap_texel(long long i, int n, Wrap mode) {
   if (mode == Wrap::kClampToEdge) return static_cast<int>(std::clamp<long long>(i, 0, n - 1));
   if (mode == Wrap::kMirroredRepeat) {

@@ -28,7 +28,7 @@ struct TriangleEmission {
 // bilinear or nearest filter can reach from a point of the triangle (its texture-space bounding
 // box grown by one texel, wrapped as the sampler wraps). `mean` is a midpoint rule over a
 // stratified grid on the triangle (16 x 16 to 32 x 32 cells, more where the triangle covers more
-// texels), with the same filter as the kernels (kernels/textures.h).
+// texels), with the same filter as the kernels (kernels/texture/textures.h).
 TriangleEmission triangle_emission(const Scene& scene, std::size_t tri);
 
 }  // namespace wp

@@ -1,5 +1,5 @@
 // Loading equirectangular environment maps and building their sampling tables. The table layout
-// is documented once, in kernels/environment.h, which reads it.
+// is documented once, in kernels/lights/environment.h, which reads it.
 #include "host/lights/environment.h"
 
 #include <algorithm>
@@ -427,7 +427,7 @@ EnvironmentMap load_environment(const std::string& path, EnvFilter filter) {
 // theta_c its centre. Weights luminance x sin(theta_c) are therefore proportional to luminance x
 // solid angle, the piecewise-constant density over (u, v) that matches radiance x Jacobian.
 // Bilinear tables use f(x, y) = the largest luminance of the 3 x 3 texels around (x, y) instead,
-// which bounds the interpolated luminance over the texel (kernels/environment.h says why).
+// which bounds the interpolated luminance over the texel (kernels/lights/environment.h says why).
 void build_environment_tables(EnvironmentMap& env, EnvFilter filter) {
   validate(env);
   env.filter = filter;

@@ -1,5 +1,5 @@
 // Environment lighting: an equirectangular radiance map (.hdr by a bounded reader of its own, .exr
-// via OpenEXR) and the tables that importance-sample it (kernels/environment.h reads them).
+// via OpenEXR) and the tables that importance-sample it (kernels/lights/environment.h reads them).
 //
 // Direction convention (+Y up, glTF's frame): the map's u runs with the azimuth
 // phi = atan2(d.x, -d.z), u = (phi + pi) / (2 pi), so the centre column (u = 0.5) is seen looking
@@ -14,9 +14,10 @@
 
 namespace wp {
 
-// How escaped rays look the map up (--env-filter; kernels/environment.h): the nearest texel, or
-// bilinear interpolation between the four texel centres around the direction. The sampling tables
-// depend on it: bilinear tables give each texel the largest luminance of its 3 x 3 neighbourhood.
+// How escaped rays look the map up (--env-filter; kernels/lights/environment.h): the nearest texel,
+// or bilinear interpolation between the four texel centres around the direction. The sampling
+// tables depend on it: bilinear tables give each texel the largest luminance of its 3 x 3
+// neighbourhood.
 enum class EnvFilter { kNearest, kBilinear };
 const char* env_filter_name(EnvFilter f);  // "nearest", "bilinear"
 
@@ -24,7 +25,7 @@ struct EnvironmentMap {
   std::string source;
   int width = 0, height = 0;
   std::vector<glm::vec4> texels;  // linear RGB radiance, row by row from the top; w unused
-  // Sampling tables in the layout kernels/environment.h expects (see there).
+  // Sampling tables in the layout kernels/lights/environment.h expects (see there).
   std::vector<float> marginal;             // per row
   std::vector<float> conditional;          // per texel
   EnvFilter filter = EnvFilter::kNearest;  // the lookup the tables were built for

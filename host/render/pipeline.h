@@ -5,7 +5,8 @@
 // pipeline_markdown; tests/test_pipeline.cpp checks that the page holds it).
 //
 // Each stage is kernels/<name>.cl, a short entry point over integrator/<name>.h; every stage kernel
-// takes the same arguments (kernels/stage.h, WP_STAGE_PARAMS), accumulate the film after them.
+// takes the same arguments (kernels/integrator/stage.h, WP_STAGE_PARAMS), accumulate the film after
+// them.
 #pragma once
 
 #include <array>
@@ -39,8 +40,8 @@ inline const char* stage_name(Stage s) {
   return kStageNames[static_cast<int>(s)];
 }
 
-// A queue by its role in a bounce (kernels/queues.h). The bounce's rays and the next bounce's are
-// the two ray queues, which swap roles every bounce (Launch::queue_in, queue_out).
+// A queue by its role in a bounce (kernels/integrator/queues.h). The bounce's rays and the next
+// bounce's are the two ray queues, which swap roles every bounce (Launch::queue_in, queue_out).
 enum class QueueRole { kNone, kRaysIn, kRaysOut, kSurface, kShadow };
 
 // The WP_QUEUE_* index of `role` in the bounce that `launch` describes; kNone has none.

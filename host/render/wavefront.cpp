@@ -39,7 +39,7 @@ std::string program_options(const SceneFeatures& features, const RenderSettings&
   if (prefetch) o += " -D WP_PREFETCH=1";
   for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
   o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
-  // kernels/features.h's WP_SAMPLER_INDEPENDENT, _SOBOL and _SOBOL_PADDED.
+  // kernels/util/features.h's WP_SAMPLER_INDEPENDENT, _SOBOL and _SOBOL_PADDED.
   o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kIndependent ? "0"
                                          : s.sampler == Sampler::kSobol     ? "1"
                                                                             : "2");
@@ -166,18 +166,18 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
   }
   const EnvironmentMap* env = settings_.environment.get();
   features_ = render_features(scene, settings);
-  // Cache hints in the stages that read path state through a queue (kernels/features.h,
+  // Cache hints in the stages that read path state through a queue (kernels/util/features.h,
   // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
   // instruction and every address space is one.
   const DeviceEntry& device = rt_.device();
   const bool pocl_cpu = !device.gpu && device.platform_name == "Portable Computing Language";
   const bool prefetch = settings.prefetch && pocl_cpu;
   options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
-  // Rays eight to a work-item (kernels/traverse8_packet.h) on the wide layout without instances
-  // or alpha: shadow rays where they are plain any-hit queries (no transmission), closest-hit
-  // rays always there. Only on PoCL's CPU devices, where it was measured (docs/performance.md,
-  // "Shadow rays in packets of eight", "Closest-hit rays in packets"), unless the settings force
-  // them (the Oclgrind tests). The same image either way.
+  // Rays eight to a work-item (kernels/traversal/traverse8_packet.h) on the wide layout without
+  // instances or alpha: shadow rays where they are plain any-hit queries (no transmission),
+  // closest-hit rays always there. Only on PoCL's CPU devices, where it was measured
+  // (docs/performance.md, "Shadow rays in packets of eight", "Closest-hit rays in packets"), unless
+  // the settings force them (the Oclgrind tests). The same image either way.
   const bool packets_here = pocl_cpu || settings.force_packets;
   const bool packets = packets_here && bvh.width == 8 && !features_.instances && !features_.alpha;
   shadow_packet_ = settings.shadow_packets && packets && !features_.transmission ? 8u : 1u;
@@ -241,7 +241,7 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh, Scene* owned_sce
   for (const auto& buffer : packed.buffers) scene_bytes_ += buffer.size();
   texture_bytes_ = packed.texel_bytes;
   mip_bytes_ = packed.mip_bytes;
-  // Which buffer holds which array is part of the program (kernels/scene.h); a scene in one
+  // Which buffer holds which array is part of the program (kernels/geom/scene.h); a scene in one
   // buffer leaves the options as they were.
   if (packed.buffer_map) {
     char map[64];
@@ -304,8 +304,8 @@ void Wavefront::build_program() {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 }
 
-// Every stage kernel takes WP_STAGE_PARAMS (kernels/stage.h), accumulate the film after them. All
-// but the Launch argument are set once, when the kernel is made.
+// Every stage kernel takes WP_STAGE_PARAMS (kernels/integrator/stage.h), accumulate the film after
+// them. All but the Launch argument are set once, when the kernel is made.
 cl::Kernel& Wavefront::kernel(Stage stage) {
   cl::Kernel& k = kernels_[static_cast<int>(stage)];
   if (k()) return k;
@@ -407,16 +407,17 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   p.max_depth = static_cast<dev::uint>(settings_.max_depth);
   p.rr_depth = static_cast<dev::uint>(settings_.rr_depth);
   p.rr_threshold = settings_.rr_threshold;
-  p.strategy = static_cast<dev::uint>(settings_.strategy);  // WP_STRATEGY_* (kernels/features.h)
+  p.strategy =
+      static_cast<dev::uint>(settings_.strategy);  // WP_STRATEGY_* (kernels/util/features.h)
   // Packets where the program has them; run_wave picks per bounce.
   p.packet = closest_packet_;
   p.shadow_packet = shadow_packet_;
   return p;
 }
 
-// Closest-hit packets (kernels/traverse8_packet.h) pay where a packet's rays share much of their
-// walk (a small scene, coherent camera rays) and cost where they part (rays past the edges of
-// objects toward the sky, glossy bounces: docs/performance.md, "Closest-hit rays in packets"),
+// Closest-hit packets (kernels/traversal/traverse8_packet.h) pay where a packet's rays share much
+// of their walk (a small scene, coherent camera rays) and cost where they part (rays past the edges
+// of objects toward the sky, glossy bounces: docs/performance.md, "Closest-hit rays in packets"),
 // and no rule on the scene alone predicts which. So each bounce index takes turns of packets and
 // single rays until each has traced kPacketTimingRays rays or been launched kPacketTimingLaunches
 // times (deep bounces trace few rays), then keeps the faster per ray; the first wave, slower for

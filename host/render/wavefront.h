@@ -28,8 +28,8 @@ namespace wp {
 
 enum class Strategy { kMis, kNee, kBsdf };
 enum class MisHeuristic { kPower, kBalance };
-// Sample pattern (kernels/rng.h): Owen-scrambled Sobol' points, the light and BSDF pairs of two
-// bounces chained to one sample order (kSobol) or every group in an order of its own
+// Sample pattern (kernels/sampling/rng.h): Owen-scrambled Sobol' points, the light and BSDF pairs
+// of two bounces chained to one sample order (kSobol) or every group in an order of its own
 // (kSobolPadded), or independent hashes.
 enum class Sampler { kSobol, kIndependent, kSobolPadded };
 // The --sampler name of a pattern ("sobol", "independent", "sobol-padded").
@@ -62,7 +62,7 @@ struct RenderSettings {
   // tables rebuilt for this one (Wavefront's constructor).
   EnvFilter env_filter = EnvFilter::kBilinear;
   // Minify textures through mip chains at the level of each path's ray cone (--mipmaps;
-  // kernels/ray_cone.h), where the scene has a texture whose sampler allows mip-maps.
+  // kernels/texture/ray_cone.h), where the scene has a texture whose sampler allows mip-maps.
   bool mipmaps = true;
   Strategy strategy = Strategy::kMis;
   MisHeuristic mis_heuristic = MisHeuristic::kPower;
@@ -82,12 +82,12 @@ struct RenderSettings {
   // (shade_surface, sample_lights, sample_bsdf, roulette_compact): the same image bit for bit
   // (pipeline.h). Fused by default: the faster on PoCL (docs/performance.md, "Fused shading").
   bool fused = true;
-  // Cache hints for the path state ahead in each queue, on PoCL's CPU devices (kernels/features.h,
-  // WP_PREFETCH); elsewhere nothing. The same image either way.
+  // Cache hints for the path state ahead in each queue, on PoCL's CPU devices
+  // (kernels/util/features.h, WP_PREFETCH); elsewhere nothing. The same image either way.
   bool prefetch = true;
   // Shadow rays traced eight to a work-item where they are plain any-hit queries, on PoCL's CPU
-  // devices with the wide BVH (kernels/traverse8_packet.h), at the bounces where the first waves
-  // timed that faster (Wavefront::packet_mode); elsewhere one each. The same image.
+  // devices with the wide BVH (kernels/traversal/traverse8_packet.h), at the bounces where the
+  // first waves timed that faster (Wavefront::packet_mode); elsewhere one each. The same image.
   bool shadow_packets = true;
   // Closest-hit rays likewise, where the program has no instances or alpha (the same walk's
   // closest-hit form: the answer does not depend on which rays share a packet).
@@ -332,7 +332,8 @@ class Wavefront {
   std::size_t wave_size_ = 0;
   std::size_t samples_per_wave_ = 1;
   std::size_t local_size_ = 0;
-  std::uint32_t shadow_packet_ = 1;   // shadow rays per work-item (kernels/traverse8_packet.h)
+  std::uint32_t shadow_packet_ =
+      1;  // shadow rays per work-item (kernels/traversal/traverse8_packet.h)
   std::uint32_t closest_packet_ = 1;  // closest-hit rays per work-item where a bounce uses packets
   std::uint32_t shade_packet_ = 1;    // paths per work-item of the fused shade kernel
   // Whether each bounce's closest-hit rays go in packets (closest_packet_ > 1 only): the faster

@@ -159,7 +159,7 @@ void read_factors(const tinygltf::Material& in, const std::string& where, Materi
 }
 
 // KHR_materials_specular: the factor scales the dielectric Fresnel term (F0 and F90), the colour
-// tints F0 (kernels/bsdf.h). specularColorFactor may exceed 1: the product with F0 is clamped.
+// tints F0 (kernels/bsdf/bsdf.h). specularColorFactor may exceed 1: the product with F0 is clamped.
 void read_specular(const tinygltf::Material& in, const std::string& where, TextureTable& textures,
                    Material& out) {
   const char* kName = "KHR_materials_specular";

@@ -1,6 +1,6 @@
 // Mip chains of texture images, built on the host and packed after each image in the device's
-// texel array (kernels/shared/types.h, TextureImage; looked up by kernels/textures.h through the
-// ray cones of kernels/ray_cone.h).
+// texel array (kernels/shared/types.h, TextureImage; looked up by kernels/texture/textures.h
+// through the ray cones of kernels/texture/ray_cone.h).
 //
 // Level k + 1 has half the width and height of level k, rounding down, and each of its texels is
 // the exact box filter of level k over the texel's footprint: the mean of the piecewise-constant

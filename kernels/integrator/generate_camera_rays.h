@@ -5,8 +5,8 @@
 #define WP_INTEGRATOR_GENERATE_CAMERA_RAYS_H
 
 #include "stage.h"
-#include "camera.h"
-#include "ray_cone.h"
+#include "camera/camera.h"
+#include "texture/ray_cone.h"
 
 /* A fresh path in `slot` on the camera ray (o, d) that starts at tmin. */
 WP_STAGE_FN void begin_path(const Camera* camera, Paths paths, Launch launch, uint slot, float3 o,

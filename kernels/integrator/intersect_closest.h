@@ -4,7 +4,7 @@
 #define WP_INTEGRATOR_INTERSECT_CLOSEST_H
 
 #include "stage.h"
-#include "traverse.h"
+#include "traversal/traverse.h"
 
 /* The fields intersect_path reads and writes, for the cache hints of the slot ahead. */
 static inline void intersect_prefetch(Paths paths, uint slot) {

@@ -9,8 +9,8 @@
 
 #include "stage.h"
 #include "integrator/roulette_compact.h"
-#include "ray_cone.h"
-#include "surface.h"
+#include "texture/ray_cone.h"
+#include "geom/surface.h"
 
 /* The next ray of the path in `slot` from surface s, seen as v (bsdf_view at -ray_d), hit at
  * distance t, with the bounce's random numbers u (its lobe choice and direction). */

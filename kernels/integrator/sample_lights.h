@@ -6,9 +6,9 @@
 #define WP_INTEGRATOR_SAMPLE_LIGHTS_H
 
 #include "stage.h"
-#include "lights.h"
-#include "mis.h"
-#include "surface.h"
+#include "lights/lights.h"
+#include "lights/mis.h"
+#include "geom/surface.h"
 
 /* NEE at surface s, seen as v (bsdf_view at -ray_d), hit at distance t, of the path in `slot`
  * with the bounce's random numbers u (its light pick and light point), weighed for `strategy`

@@ -7,10 +7,10 @@
 #define WP_INTEGRATOR_SHADE_SURFACE_H
 
 #include "stage.h"
-#include "elementary.h"
-#include "lights.h"
-#include "mis.h"
-#include "surface.h"
+#include "util/elementary.h"
+#include "lights/lights.h"
+#include "lights/mis.h"
+#include "geom/surface.h"
 
 /* The fields shade_hit reads first, for the cache hints of the slot ahead. */
 static inline void shade_prefetch(Paths paths, uint slot) {

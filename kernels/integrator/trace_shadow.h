@@ -13,8 +13,8 @@
 #define WP_INTEGRATOR_TRACE_SHADOW_H
 
 #include "stage.h"
-#include "material.h"
-#include "traverse.h"
+#include "geom/material.h"
+#include "traversal/traverse.h"
 
 #define WP_SHADOW_MAX_LAYERS 16
 

@@ -93,8 +93,8 @@ typedef struct TriBlock4 {
 
 typedef struct BvhInstance {
   /* Rows of the world-to-object affine map: x' = dot(row.xyz, x) + row.w. Shading maps the other
-   * way with its inverse, computed where it is needed (kernels/instance.h): 48 bytes an instance
-   * fewer than storing both. */
+   * way with its inverse, computed where it is needed (kernels/geom/instance.h): 48 bytes an
+   * instance fewer than storing both. */
   float4 to_object[3];
   uint4 meta; /* x: the mesh's root node; y: the light of the mesh's first emissive triangle here,
                  or WP_NO_LIGHT (host/lights/light_table.h); z: WP_INSTANCE_* flags; w: mesh */

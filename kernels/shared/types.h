@@ -46,9 +46,9 @@
 /* Path flags (path_flags in the path state). */
 #define WP_PATH_DELTA 1u         /* the last scattering event was a delta (specular) lobe */
 #define WP_PATH_CHANNEL_SHIFT 1u /* bits 1-2: the colour channel a dispersive refraction chose */
-#define WP_PATH_CHANNEL_MASK 6u  /* (1 R, 2 G, 3 B; 0: all three), kernels/bsdf.h */
+#define WP_PATH_CHANNEL_MASK 6u  /* (1 R, 2 G, 3 B; 0: all three), kernels/bsdf/bsdf.h */
 
-/* Queues: index arrays of path slots with an atomic counter each (see kernels/queues.h). */
+/* Queues: index arrays of path slots with an atomic counter each (integrator/queues.h). */
 #define WP_QUEUE_RAY_A 0u /* rays to trace; A and B swap roles every bounce */
 #define WP_QUEUE_RAY_B 1u
 #define WP_QUEUE_SURFACE 2u /* paths whose ray hit a surface this bounce */
@@ -97,7 +97,7 @@ typedef struct TextureRef {
   uint4 meta; /* x: TextureImage index; y: wrap S (bits 0-7) | wrap T (bits 8-15) | WP_TEX_* flags;
                  z: texture coordinate set (0 or 1); w: the bits of a float, the texture's term
                  of its mip level, 1/2 log2(width x height x |det| of the transform's 2 x 2 part)
-                 (kernels/ray_cone.h), or -INFINITY: no mip-maps (level 0 always) */
+                 (kernels/texture/ray_cone.h), or -INFINITY: no mip-maps (level 0 always) */
 } TextureRef;
 
 /* A decoded image: width x height texels, row by row from the top (glTF's uv (0,0) is the
@@ -139,10 +139,10 @@ typedef struct Camera {
 
 /* The scene's arrays lie in up to WP_SCENE_BUFFERS device buffers, each no larger than the
  * device's largest allocation (host/device/device_scene.h). Which buffer holds an array is fixed
- * when the program is built: WP_SCENE_BUFFER_MAP (kernels/scene.h), WP_SCENE_BUFFER_BITS per array
- * in SceneDesc's order, so every scene pointer is one kernel argument plus an offset (a buffer
- * index known only at run time made every kernel slower on PoCL). The offset of each array in
- * its buffer is in SceneDesc, in units of WP_SCENE_ALIGN bytes: a uint reaches 256 GiB. */
+ * when the program is built: WP_SCENE_BUFFER_MAP (kernels/geom/scene.h), WP_SCENE_BUFFER_BITS per
+ * array in SceneDesc's order, so every scene pointer is one kernel argument plus an offset (a
+ * buffer index known only at run time made every kernel slower on PoCL). The offset of each array
+ * in its buffer is in SceneDesc, in units of WP_SCENE_ALIGN bytes: a uint reaches 256 GiB. */
 #define WP_SCENE_BUFFERS 8
 #define WP_SCENE_BUFFER_BITS 3
 #define WP_SCENE_ALIGN 64
@@ -170,7 +170,7 @@ typedef struct SceneDesc {
                        instanced scene its index among its mesh's emissive triangles, the light
                        being that plus the instance's first (BvhInstance.meta.y) */
   uint env_texels;   /* float4[] env_width x env_height, linear RGB radiance, rows from +Y down */
-  uint env_marginal; /* environment sampling tables (kernels/environment.h) */
+  uint env_marginal; /* environment sampling tables (kernels/lights/environment.h) */
   uint env_conditional;
   uint env_width, env_height;
   uint light_count;

@@ -1,4 +1,4 @@
-/* Test kernels of tests/test_anisotropy.cpp: anisotropic GGX (kernels/ggx_aniso.h).
+/* Test kernels of tests/test_anisotropy.cpp: anisotropic GGX (kernels/bsdf/ggx_aniso.h).
  *
  * A sampling configuration is (v, p): v.xyz = wo, a unit direction in the frame of the bins
  * (tests/sphere_bins.h, the pole on the normal: (c, phi) -> (s cos phi, s sin phi, c),
@@ -6,8 +6,8 @@
  * x axis turned by psi about the normal, t = (cos psi, sin psi, 0), b = n x t. wo and the
  * microfacet normals are taken to the anisotropy frame (t, b, n) for ggx_aniso.h and back, so a
  * turned frame checks that the routines hold for a view out of the (t, n) plane. */
-#include "ggx_aniso.h"
-#include "rng.h"
+#include "bsdf/ggx_aniso.h"
+#include "sampling/rng.h"
 
 /* Sample kinds, in draw_aniso's dir.w. */
 #define SK_INVALID 0.0f
@@ -33,7 +33,7 @@ static inline float rel_error(float x, float ref) {
 /* From: a configuration, a seed. To: `count` samples, dir = (l, SK_* kind), l = reflect(wo, h)
  * in the bins frame for h = sample_ggx_aniso_visible_normal; check = (relative error of the
  * sample's pdf, from the sampled h, against reflection_pdf at l; | |h| - 1 |; h.z in the
- * anisotropy frame; the pdf). Sample i uses the hash stream of "pixel" i (kernels/rng.h). */
+ * anisotropy frame; the pdf). Sample i uses the hash stream of "pixel" i (sampling/rng.h). */
 __kernel void draw_aniso(float4 v, float4 p, uint seed, uint count, __global float4* dirs,
                          __global float4* checks) {
   const uint i = get_global_id(0);
@@ -94,7 +94,7 @@ __kernel void integrate_aniso_pdf(float4 v, float4 p, __global const float4* rec
  * Out: 8 float4 per item, out[8 i + k]:
  *   k = 0: (D(w), Lambda(wo), G1(wo), V(wo, w))
  *   k = 1: (pdf(wo, h = w), Lambda(w), G1(w), 0)
- *   k = 2: sampling.h with alpha = ax: (ggx_d(w.z, w.x^2 + w.y^2), ggx_g1(wo.z),
+ *   k = 2: sampling/warps.h with alpha = ax: (ggx_d(w.z, w.x^2 + w.y^2), ggx_g1(wo.z),
  *          ggx_visibility(w.z, wo.z), ggx_reflection_pdf(wo.z, w.z, w.x^2 + w.y^2))
  *   k = 3: (h = sample_ggx_aniso_visible_normal(wo, ax, ay, u), pdf(wo, h))
  *   k = 4: (sample_ggx_visible_normal(wo, ax, u), 0)

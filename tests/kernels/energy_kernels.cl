@@ -6,7 +6,7 @@
  * The surface: shading and geometric normal tilted_normal() (not an axis, so the BSDF's own frame
  * is exercised), base colour `color` (grey: every channel alike, channel x reported), metallic,
  * roughness, ior and transmission in params, Surface flags in `flags`, wo at cosine cos_o to the
- * normal. Per sample i (hash stream of "pixel" i, kernels/rng.h), out[i] =
+ * normal. Per sample i (hash stream of "pixel" i, kernels/sampling/rng.h), out[i] =
  *   x: BSDF sampling alone: bsdf_sample's weight (0 for an invalid sample);
  *   y: both strategies of the renderer with MIS: the BSDF sample weighted against a uniform
  *      sphere "light" (the constant background's NEE pdf, 1 / 4 pi), plus one uniform light sample
@@ -15,9 +15,9 @@
  *      where bsdf_only_delta;
  *   z: 1 when any value on the way was NaN or infinite, else 0;
  *   w: unused. */
-#include "bsdf.h"
-#include "mis.h"
-#include "rng.h"
+#include "bsdf/bsdf.h"
+#include "lights/mis.h"
+#include "sampling/rng.h"
 
 inline float3 tilted_normal(void) {
   return normalize((float3)(0.3f, -0.5f, 0.8f));

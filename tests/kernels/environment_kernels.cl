@@ -1,8 +1,8 @@
-/* Test kernels for kernels/environment.h (tests/test_environment.cpp). Each takes a SceneDesc by
- * value (env_width/env_height/env_params/background set, offsets unused) and the three
+/* Test kernels for kernels/lights/environment.h (tests/test_environment.cpp). Each takes a
+ * SceneDesc by value (env_width/env_height/env_params/background set, offsets unused) and the three
  * environment arrays as separate buffers, and builds the part of a SceneView they read. */
-#include "environment.h"
-#include "rng.h"
+#include "lights/environment.h"
+#include "sampling/rng.h"
 
 inline SceneView env_view(const SceneDesc* d, __global const float4* texels,
                           __global const float* marginal, __global const float* conditional) {

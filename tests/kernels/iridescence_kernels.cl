@@ -1,4 +1,4 @@
-/* Test kernels for tests/test_iridescence.cpp: kernels/iridescence.h's functions at given
+/* Test kernels for tests/test_iridescence.cpp: kernels/bsdf/iridescence.h's functions at given
  * arguments, so that the host can hold them against its float64 spectral reference and limits.
  *
  * film: args[i] = (outside_ior, film_ior, thickness_nm, cos1), f0[i] = base F0 (xyz);
@@ -8,7 +8,7 @@
  *   for iridescence_thickness_nm(100, 400, g): written to out_metal[i].w), colour[i] = base colour
  *   (xyz); out_dielectric[i] = (iridescence_dielectric_fresnel, iridescence_base_weight of it),
  *   out_metal[i].xyz = iridescence_metal_fresnel. */
-#include "iridescence.h"
+#include "bsdf/iridescence.h"
 
 __kernel void film(__global const float4* args, __global const float4* f0, uint count,
                    __global float4* out) {

@@ -1,11 +1,11 @@
 /* Test kernels of tests/test_sampling.cpp (LaneTwins.*): the eight-lane twins of common.h,
- * elementary.h and sampling.h, which the packet kernels (integrator/shade_packet.h,
+ * elementary.h and sampling/warps.h, which the packet kernels (integrator/shade_packet.h,
  * traverse8_packet.h) use in place of their scalar originals and so must match bit for bit, each
  * beside its original on the same inputs. Built with WP_SHADE_PACKET=1 (the twins exist only
  * there), with and without WP_PREFETCH=1 (the x86 builtins of lane_bits8 and all8, or their
  * generic forms). */
-#include "common.h"
-#include "sampling.h"
+#include "util/common.h"
+#include "sampling/warps.h"
 
 /* Work-item g takes in[8g .. 8g + 8): a vector (xyz) and a number (w) per lane. Function `fn` of
  * each lane's input goes to lanes[8g + i] by the twin and to scalar[8g + i] by the original:

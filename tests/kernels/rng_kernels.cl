@@ -1,12 +1,12 @@
-/* Test kernel of tests/test_rng.cpp: the random numbers of kernels/rng.h at given coordinates, so
- * that the host can check their distribution (uniformity, stratification, independence). Built
- * with -D WP_SAMPLER=0, 1 or 2.
+/* Test kernel of tests/test_rng.cpp: the random numbers of kernels/sampling/rng.h at given
+ * coordinates, so that the host can check their distribution (uniformity, stratification,
+ * independence). Built with -D WP_SAMPLER=0, 1 or 2.
  *
  * coords[i] = (pixel, sample, bounce, dim | pair << 16); out[i] = rng_get2(r, dim) when pair is 1,
  * else (rng_get(r, dim), 0). draw_bounce: out[i] = rng_bounce(r), all of a bounce's numbers at
  * once (the dim of coords[i] unused). sobol_pair_digits: out[i] = rng_sobol_pair_digits(in[i], p)
  * (Sobol' builds only). */
-#include "rng.h"
+#include "sampling/rng.h"
 
 __kernel void draw_rng(__global const uint4* coords, uint seed, uint count, __global float2* out) {
   const uint i = get_global_id(0);

@@ -24,9 +24,9 @@
  * Bins (tests/sphere_bins.h) are uniform in (c, phi); `frame` says how they lie in the routine's
  * frame: BF_POLE_Y: (c, phi) -> (s cos phi, c, s sin phi), s = sqrt(1 - c^2), the pole on the
  * horizon; BF_POLE_Z: (c, phi) -> (s cos phi, s sin phi, c), the pole on the normal. */
-#include "bsdf.h"
-#include "lights.h"
-#include "rng.h"
+#include "bsdf/bsdf.h"
+#include "lights/lights.h"
+#include "sampling/rng.h"
 
 #define ST_COSINE 0u
 #define ST_GGX 1u
@@ -293,9 +293,9 @@ inline void draw_other(const Config* c, const SceneView* scene, float2 u, float4
       test_scene(positions, tri_vertices, materials, tri_light, light_alias, (const SceneDesc*)0)
 
 /* From: a configuration, a seed. To: `count` samples, dir = (local direction, SK_* kind) and
- * check (see draw_bsdf / draw_other). Sample i uses the hash stream of "pixel" i (kernels/rng.h):
- * each random number is a full-avalanche hash of (seed, dimension, i), so numbers of different
- * samples and dimensions are as independent as the hash makes them. */
+ * check (see draw_bsdf / draw_other). Sample i uses the hash stream of "pixel" i
+ * (kernels/sampling/rng.h): each random number is a full-avalanche hash of (seed, dimension, i), so
+ * numbers of different samples and dimensions are as independent as the hash makes them. */
 __kernel void draw_samples(WP_CONFIG_PARAMS, uint seed, uint count, __global float4* dirs,
                            __global float4* checks) {
   const uint i = get_global_id(0);

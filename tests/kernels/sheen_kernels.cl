@@ -1,6 +1,6 @@
-/* Test kernels for tests/test_sheen.cpp: the sheen lobe's functions (kernels/sheen.h) on the
+/* Test kernels for tests/test_sheen.cpp: the sheen lobe's functions (kernels/bsdf/sheen.h) on the
  * device, for the host to hold against its float64 evaluation of the extension's formulas. */
-#include "sheen.h"
+#include "bsdf/sheen.h"
 
 /* Per item i: n = in[3i].xyz, wo = in[3i + 1].xyz with alpha in in[3i + 1].w, wi = in[3i + 2].xyz;
  * out[i] = (sheen_eval, sheen_lambda(n.wo), sheen_lambda(n.wi), 0). */

@@ -1,9 +1,9 @@
 /* Test kernels for tests/test_textures.cpp: texture sampling (textures.h), material alpha
  * (alpha.h) and the resolved surface (material.h), each over a scene packed by
  * host/device/device_scene.cpp and queried item by item. */
-#include "alpha.h"
-#include "material.h"
-#include "textures.h"
+#include "traversal/alpha.h"
+#include "geom/material.h"
+#include "texture/textures.h"
 
 /* out[i] = texture_sample(refs[i], uvs[i]). */
 __kernel void sample_textures(WP_SCENE_PARAMS, __global const int* refs, __global const float4* uvs,

@@ -14,7 +14,7 @@
 // The scene: the published Cornell box with KHR_materials_specular's factor set to 0 on every
 // material. glTF's default factor is 1, a dielectric Fresnel layer over the diffuse base, which
 // makes the program glossy (host/device/scene_features.cpp); with 0 the BSDF is Lambert's alone
-// (kernels/bsdf.h, WP_FEATURE_GLOSSY 0), whose sample weight, pdf and light-sample value have
+// (kernels/bsdf/bsdf.h, WP_FEATURE_GLOSSY 0), whose sample weight, pdf and light-sample value have
 // closed forms. A small constant background makes escaped rays count and adds an environment
 // light to the light table next to the two emissive triangles of the ceiling light, so both
 // kinds of light sample and both MIS cases (emission and background found by BSDF sampling)
@@ -64,7 +64,7 @@ constexpr int kBounces = 3;  // bounce starts captured: the camera rays and two 
 inline const vec3 kBackground(0.02f, 0.03f, 0.05f);
 constexpr double kPi = 3.14159265358979323846;
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr std::uint32_t kSurfFront = 4u;  // WP_SURF_FRONT of kernels/bsdf.h (OpenCL C only)
+constexpr std::uint32_t kSurfFront = 4u;  // WP_SURF_FRONT of kernels/bsdf/bsdf.h (OpenCL C only)
 
 using wp::test::as_float;
 using wp::test::bits;
@@ -176,7 +176,7 @@ inline std::vector<std::uint32_t> all_slots() {
 }
 
 // The entries of a queue as a set, failing on an entry that is out of range or there twice (the
-// queue invariant, kernels/queues.h).
+// queue invariant, kernels/integrator/queues.h).
 inline std::set<std::uint32_t> queue_set(const std::vector<std::uint32_t>& q, const char* name) {
   std::set<std::uint32_t> s;
   Failures f(std::string("queue ") + name + " holds distinct slots of the wave");
@@ -188,7 +188,7 @@ inline std::set<std::uint32_t> queue_set(const std::vector<std::uint32_t>& q, co
 }
 
 // Power-heuristic MIS weight of a strategy with pdf `own` against one with pdf `other`
-// (kernels/mis.h; RenderSettings' default heuristic).
+// (kernels/lights/mis.h; RenderSettings' default heuristic).
 inline double power_weight(double own, double other) {
   return own * own / (own * own + other * other);
 }
@@ -301,8 +301,8 @@ class Stages : public ::testing::Test {
   // The two traversal stages run on both BVH layouts: the device's (wf_, bvh_) and the other one
   // (binary on a CPU device, 8-wide on a GPU), a Wavefront of the same scene and settings made on
   // first use, whose path state has the same layout, so that it takes the same captured states;
-  // where the device's program traces rays in packets (kernels/traverse8_packet.h), once more on
-  // its layout with one ray per work-item.
+  // where the device's program traces rays in packets (kernels/traversal/traverse8_packet.h), once
+  // more on its layout with one ray per work-item.
   struct Traversal {
     wp::Wavefront* wf;
     const wp::bvh::Bvh* bvh;

@@ -8,9 +8,9 @@ namespace {
 // generate_camera_rays: every slot of the wave once in the ray queue, a fresh path (throughput 1,
 // radiance 0, eta scale 1, bounce 0, no flags, no BSDF pdf), pixel = pixel_offset + slot %
 // wave_pixels, and a ray from the eye that, projected back through the host's device camera
-// (device_camera, kernels/camera.h), falls inside its pixel's square. Two waves: the whole image
-// with 4 samples per pixel, and a part of it from pixel 500 with 3 samples from sample index 7;
-// slots past the wave's paths are left alone.
+// (device_camera, kernels/camera/camera.h), falls inside its pixel's square. Two waves: the whole
+// image with 4 samples per pixel, and a part of it from pixel 500 with 3 samples from sample index
+// 7; slots past the wave's paths are left alone.
 TEST_F(Stages, GenerateCameraRaysStartEveryPathInItsPixel) {
   const wp::dev::Camera cam = wp::device_camera(scene_->cameras.at(0), kWidth, kHeight);
   const dvec3 eye = dxyz(cam.position), fwd = dxyz(cam.forward), right = dxyz(cam.right),

@@ -83,7 +83,8 @@ TEST_F(Stages, ShadeSurfaceResolvesHitsEmissionAndBackground) {
         ++emitter_hits;
         double w = 1.0;
         if (b > 0) {
-          // NEE's pdf of this point: the light's pmf x dist^2 / (area cos) (kernels/lights.h).
+          // NEE's pdf of this point: the light's pmf x dist^2 / (area cos)
+          // (kernels/lights/lights.h).
           const double area = 0.5 * glm::length(t.cross);
           const double cos_l = std::fabs(glm::dot(glm::normalize(t.cross), d));
           const double p_light =
@@ -168,13 +169,14 @@ TEST_F(Stages, ShadeSurfaceResolvesHitsEmissionAndBackground) {
 }
 
 // sample_lights: every shadow-queue slot is a surface-queue slot, once; its shadow ray starts just
-// off the surface point (at most 2 offset distances, kernels/surface.h) on the side of the normal
-// the light is on, has a unit direction and either ends (origin + dir x tmax) on the emitting side
-// of an emissive triangle of the host's scene, within the offset that keeps it off that triangle,
-// or has tmax = INFINITY (the environment light). Its contribution is finite, positive and equal to
-// a host evaluation of throughput x f x L x cos / pdf x w_light for Lambert's f = base / pi, the
-// pdf of the light point (pmf x dist^2 / (area cos_light), or pmf / 4 pi for the background) and
-// the power heuristic against the BSDF's pdf cos / pi (tolerance below). Only shadow fields change.
+// off the surface point (at most 2 offset distances, kernels/geom/surface.h) on the side of the
+// normal the light is on, has a unit direction and either ends (origin + dir x tmax) on the
+// emitting side of an emissive triangle of the host's scene, within the offset that keeps it off
+// that triangle, or has tmax = INFINITY (the environment light). Its contribution is finite,
+// positive and equal to a host evaluation of throughput x f x L x cos / pdf x w_light for Lambert's
+// f = base / pi, the pdf of the light point (pmf x dist^2 / (area cos_light), or pmf / 4 pi for the
+// background) and the power heuristic against the BSDF's pdf cos / pi (tolerance below). Only
+// shadow fields change.
 TEST_F(Stages, SampleLightsMakesShadowRaysToLightPoints) {
   ASSERT_FALSE(wf_->features().glossy) << "Lambert's BSDF alone: " << wf_->features().describe();
   const std::vector<Emitter> lights_geometry = emitters();
@@ -182,8 +184,9 @@ TEST_F(Stages, SampleLightsMakesShadowRaysToLightPoints) {
   const auto& lights = wf_->lights();
   // From a point that sees the emitting side of the whole light above both its normals, every
   // point of the light makes a shadow ray, so the points sampled there are uniform over the
-  // light's area (kernels/lights.h, sample_triangle): each barycentric coordinate has mean 1/3 and
-  // standard deviation sqrt(1/18) (a flat Dirichlet's marginal), checked within 5 standard errors.
+  // light's area (kernels/lights/lights.h, sample_triangle): each barycentric coordinate has mean
+  // 1/3 and standard deviation sqrt(1/18) (a flat Dirichlet's marginal), checked within 5 standard
+  // errors.
   const auto sees_whole_light = [&](dvec3 p, dvec3 ns, dvec3 ng) {
     for (const Emitter& em : lights_geometry) {
       if (!(glm::dot(p - em.t.p[0], em.t.cross) > 0.0)) return false;
@@ -275,8 +278,8 @@ TEST_F(Stages, SampleLightsMakesShadowRaysToLightPoints) {
           ++bary_n;
         }
         // The target is the light point q moved off the light toward its emitting (front) side by
-        // 2^-16 of q's magnitude bound (kernels/lights.h, sample_triangle), and e is that target
-        // up to the rounding of o + dir tmax and of the target itself, far below 16 ulps of
+        // 2^-16 of q's magnitude bound (kernels/lights/lights.h, sample_triangle), and e is that
+        // target up to the rounding of o + dir tmax and of the target itself, far below 16 ulps of
         // coordinates below 1 (2^-20).
         const dvec3 n = glm::normalize(hit->t.cross);
         const dvec3 scale = glm::abs((1.0 - b1 - b2) * hit->t.p[0]) + glm::abs(b1 * hit->t.p[1]) +
@@ -542,8 +545,8 @@ TEST_F(Stages, RouletteCompactKeepsPathsWithProbabilityQ) {
 // path state and the queues exactly as shade_surface, sample_lights, sample_bsdf and
 // roulette_compact do in turn: every field bit for bit but the surface record (the fused kernel
 // keeps it in registers), the shadow and next ray queues as sets (their order depends on which
-// work-group reached the counter first, kernels/queues.h). Bounces 0 to 2, with the render's
-// roulette settings and with roulette at once (rr_depth 0). The scene is Lambertian and
+// work-group reached the counter first, kernels/integrator/queues.h). Bounces 0 to 2, with the
+// render's roulette settings and with roulette at once (rr_depth 0). The scene is Lambertian and
 // untextured, so on PoCL's CPU devices the fused kernel shades eight paths per work-item in SIMD
 // lanes (kernels/integrator/shade_packet.h), and this compares that with the single-path stages.
 TEST_F(Stages, ShadeDoesWhatTheSplitStagesDo) {

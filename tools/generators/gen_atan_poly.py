@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Prints the coefficients of atan_poly (kernels/sampling.h): atan(a) ~ a P(a^2) on [0, 1], P of
+"""Prints the coefficients of atan_poly (kernels/sampling/warps.h): atan(a) ~ a P(a^2) on [0, 1], P of
 degree 8, fitted for the least largest absolute error by Lawson's iteratively reweighted least
 squares on a dense grid (the weights converge to the minimax error's alternation points), in
 double precision; then the fit's largest error in double and, with the coefficients rounded to

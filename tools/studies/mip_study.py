@@ -42,7 +42,7 @@ ASSETS = os.path.join(accuracy_lib.REPO, "..", "shared", "assets")
 ENV = os.path.join(ASSETS, "env", "studio_small_03_1k.hdr")
 # Two textured models seen small (the whole model a few dozen pixels across in a 256 x 256 image),
 # and DamagedHelmet framed whole (wavepath's framing camera, as tools/peers.py --pbr renders it),
-# whose surfaces edge-on to the view test the footprint at grazing angles (kernels/ray_cone.h).
+# whose surfaces edge-on to the view test the footprint at grazing angles (kernels/texture/ray_cone.h).
 HELMET = os.path.join(ASSETS, "models", "DamagedHelmet", "DamagedHelmet.glb")
 DEFAULT_CASES = [
     "DamagedHelmet:%s:--orbit 30,75,14 --env %s" % (HELMET, ENV),

@@ -10,7 +10,7 @@ scene, so light reflects once: a pixel's value is the average over its footprint
     point light (intensity I, W/sr, at p):   E = I cos(theta) / d^2
     spot light (also direction a, cone angles inner/outer): the same times KHR_lights_punctual's
         recommended falloff clamp((cos_d - cos_outer) / (cos_inner - cos_outer), 0, 1)^2 with
-        cos_d = a . (x - p) / d (wavepath's kernels/lights.h)
+        cos_d = a . (x - p) / d (wavepath's kernels/lights/lights.h)
     emissive polygon (radiance Le, front toward the plane, wholly above it): Lambert's formula
         E = Le / 2 * sum_k theta_k n . unit(r_k x r_{k+1}),  r_k = v_k - x,
         theta_k the angle between r_k and r_{k+1}, n = +Y (the sign depends on the winding: the

@@ -4,11 +4,11 @@
 #ifndef WP_STAGE_H
 #define WP_STAGE_H
 
-#include "common.h"
-#include "rng.h"
+#include "util/common.h"
+#include "sampling/rng.h"
 #include "path_state.h"
 #include "queues.h"
-#include "scene.h"
+#include "geom/scene.h"
 
 /* The arguments every stage kernel takes, in this order (host/render/wavefront.cpp binds them). */
 #define WP_STAGE_PARAMS                                                                          \

@@ -44,7 +44,7 @@
 #define WP_FEATURE_ENVIRONMENT 1 /* an environment map (else a constant background) */
 #endif
 #ifndef WP_ENV_BILINEAR
-#define WP_ENV_BILINEAR 0 /* --env-filter bilinear: the map's lookup (kernels/environment.h) */
+#define WP_ENV_BILINEAR 0 /* --env-filter bilinear: the map's lookup (lights/environment.h) */
 #endif
 #ifndef WP_FEATURE_VERTEX_COLORS
 #define WP_FEATURE_VERTEX_COLORS 1 /* COLOR_0 multiplies the base colour */
@@ -76,8 +76,8 @@
 #define WP_FEATURE_VOLUME 1 /* KHR_materials_volume: refraction and absorption */
 #endif
 
-/* The material extensions beyond metallic-roughness (kernels/bsdf.h), each compiled in only when
- * a material of the scene uses it (host/device/scene_features.cpp). */
+/* The material extensions beyond metallic-roughness (kernels/bsdf/bsdf.h), each compiled in only
+ * when a material of the scene uses it (host/device/scene_features.cpp). */
 #ifndef WP_FEATURE_SPECULAR
 #define WP_FEATURE_SPECULAR 1 /* KHR_materials_specular colour or textures */
 #endif

@@ -12,7 +12,7 @@
 #ifndef WP_PATH_STATE_H
 #define WP_PATH_STATE_H
 
-#include "common.h"
+#include "util/common.h"
 
 typedef struct Paths {
 #define WP_PATH_FIELD(type, name, description) __global type* name;

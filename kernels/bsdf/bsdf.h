@@ -36,8 +36,8 @@
  *   Fc = 0.04 + 0.96 (1 - |nc.wo|)^5 at the coat normal nc (the extension's fresnel_coat, which
  *        takes n.v, not v.h, so that (1 - cc Fc) + cc Fc E_c <= 1); D_c V_c GGX about nc with
  *        alpha = clearcoatRoughness^2, for wi above nc. cc = 0 without the coat.
- *   D_s V_s: the Charlie sheen lobe of kernels/sheen.h about ns (alpha = sheenRoughness^2), for
- *        wi above; S = min(1 - max3(sheenColor) E(|n.wo|), 1 - max3(sheenColor) E(|n.wi|)),
+ *   D_s V_s: the Charlie sheen lobe of kernels/bsdf/sheen.h about ns (alpha = sheenRoughness^2),
+ *        for wi above; S = min(1 - max3(sheenColor) E(|n.wo|), 1 - max3(sheenColor) E(|n.wi|)),
  *        E the lobe's directional albedo (a table, sheen.h), clamped at 0. S = 1 without sheen.
  * Every lobe is integrated against ns's cosine (f |ns.wi| is what the integrator multiplies).
  *
@@ -67,8 +67,8 @@
 #ifndef WP_BSDF_H
 #define WP_BSDF_H
 
-#include "common.h"
-#include "sampling.h"
+#include "util/common.h"
+#include "sampling/warps.h"
 /* The extensions' pieces; included whatever the features (the source expander takes each header
  * once), used only where their feature is on. */
 #include "ggx_aniso.h"
@@ -77,7 +77,7 @@
 
 /* A surface whose GGX alpha (roughness^2) is below this is perfectly smooth. The lobe of alpha
  * 1e-3 is ~0.06 degrees wide: narrower than any pixel of a sensible camera, and the float32
- * evaluation of a narrower one loses its precision (sampling.h, ggx_d). */
+ * evaluation of a narrower one loses its precision (sampling/warps.h, ggx_d). */
 #define WP_DELTA_ALPHA 1e-3f
 
 /* Surface flags. */
@@ -222,7 +222,7 @@ static inline bool has_sheen(const Surface* s) {
   return max3(s->sheen_color) > 0.0f;
 }
 /* 1 - max3(sheen colour) E: the share the sheen leaves to the base for one direction whose
- * sheen albedo is E (never below 0: E exceeds 1 for smooth sheens, kernels/sheen.h). */
+ * sheen albedo is E (never below 0: E exceeds 1 for smooth sheens, kernels/bsdf/sheen.h). */
 static inline float sheen_leaves_e(const Surface* s, float e) {
   return fmax(0.0f, 1.0f - max3(s->sheen_color) * e);
 }
@@ -582,10 +582,10 @@ static inline void eval_diffuse_transmission(const Surface* s, float3 wo, float3
 
 #if WP_BSDF_LAYERED
 /* The layers over the base for a wi above or below: the base's f scaled (layer_base_scale), the
- * sheen (its colour x D V of kernels/sheen.h, under the coat) and the rough coat (GGX about the
- * coat normal, clearcoat x Fc x D V) added for wi above, with their pdfs (cosine-weighted for the
- * sheen, the coat normal's visible normals for the coat). Each lobe is counted with ns's cosine,
- * as the rest of the BSDF. */
+ * sheen (its colour x D V of kernels/bsdf/sheen.h, under the coat) and the rough coat (GGX about
+ * the coat normal, clearcoat x Fc x D V) added for wi above, with their pdfs (cosine-weighted for
+ * the sheen, the coat normal's visible normals for the coat). Each lobe is counted with ns's
+ * cosine, as the rest of the BSDF. */
 static inline void eval_layers(const Surface* s, float3 wo, float3 wi, float cos_o, float cos_i,
                                bool above, Lobes l, BsdfEval* e) {
   float coat = 0.0f; /* the coat's share at wo */

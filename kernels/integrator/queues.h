@@ -13,7 +13,7 @@
 #ifndef WP_QUEUES_H
 #define WP_QUEUES_H
 
-#include "common.h"
+#include "util/common.h"
 
 typedef struct Queues {
   __global uint* slots;    /* WP_QUEUE_COUNT arrays of `capacity` entries */

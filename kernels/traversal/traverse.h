@@ -9,7 +9,7 @@
 #ifndef WP_TRAVERSE_H
 #define WP_TRAVERSE_H
 
-#include "common.h"
+#include "util/common.h"
 #include "alpha.h"
 
 /* No fused multiply-adds here: the CPU reference is written without them, and with contraction

@@ -13,7 +13,7 @@
 #ifndef WP_MIS_H
 #define WP_MIS_H
 
-#include "common.h"
+#include "util/common.h"
 
 /* Written with the ratio r = p_other / p_own: p^2 / (p^2 + q^2) overflows to inf / inf = NaN for
  * pdfs above ~1.8e19 (a near-delta lobe or a tiny light seen edge-on reaches that), while

@@ -14,11 +14,11 @@
 #ifndef WP_CAMERA_H
 #define WP_CAMERA_H
 
-#include "common.h"
+#include "util/common.h"
 
-/* Defined in sampling.h, which is not included here: the program is one translation unit of every
- * stage, this file comes first in it, and traverse.h's `FP_CONTRACT OFF` holds for all that
- * follows it, sampling.h included -- which must stay after it to keep its arithmetic. */
+/* Defined in sampling/warps.h, which is not included here: the program is one translation unit of
+ * every stage, this file comes first in it, and traverse.h's `FP_CONTRACT OFF` holds for all that
+ * follows it, sampling/warps.h included -- which must stay after it to keep its arithmetic. */
 static inline float2 sample_concentric_disk(float2 u);
 
 /* Whether camera_ray uses a lens sample: only then is one drawn. */

@@ -3,8 +3,8 @@
 #ifndef WP_SURFACE_H
 #define WP_SURFACE_H
 
-#include "bsdf.h"
-#include "path_state.h"
+#include "bsdf/bsdf.h"
+#include "integrator/path_state.h"
 
 static inline void surface_store(Paths paths, uint slot, const Surface* s) {
   path_store_surf_p(paths, slot, s->p, s->p_scale);

@@ -2,7 +2,7 @@
 #ifndef WP_SCENE_H
 #define WP_SCENE_H
 
-#include "common.h"
+#include "util/common.h"
 
 typedef struct SceneView {
   __global const BvhNode* nodes;

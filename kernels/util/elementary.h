@@ -169,8 +169,8 @@ static inline float cos_poly(float x) {
 /* atan2(y, x) in [-pi, pi] (an environment map's lookup at every escaped ray took 12% of a render
  * of an environment-lit model in PoCL's atan2). The angle of the smaller coordinate over the
  * larger, a = min(|x|, |y|) / max(|x|, |y|) in [0, 1], from a P(a^2), P of degree 8 fitted to atan
- * on [0, 1] (tools/generators/gen_atan_poly.py: 5.8e-9 at worst, 1.1e-7 with float coefficients and Horner
- * in float), moved to its octant: pi/2 - r where |y| > |x|, pi - r where x's sign bit is set
+ * on [0, 1] (tools/generators/gen_atan_poly.py: 5.8e-9 at worst, 1.1e-7 with float coefficients and
+ * Horner in float), moved to its octant: pi/2 - r where |y| > |x|, pi - r where x's sign bit is set
  * (x = -0 too, as IEEE's atan2), then the sign of y. (0, 0) gives 0 or pi with y's sign; x and y
  * finite. */
 static inline float atan2_poly(float y, float x) {

@@ -8,9 +8,9 @@
 #ifndef WP_ALPHA_H
 #define WP_ALPHA_H
 
-#include "rng.h"
-#include "scene.h"
-#include "textures.h" /* unconditionally: the source expander includes each header once */
+#include "sampling/rng.h"
+#include "geom/scene.h"
+#include "texture/textures.h" /* unconditionally: the source expander includes each header once */
 
 /* The material alpha of triangle `tri` at barycentrics (u, v) of its vertices 1 and 2. */
 static inline float material_alpha(const SceneView* scene, uint tri, float u, float v) {

@@ -49,8 +49,8 @@
 #ifndef WP_ENVIRONMENT_H
 #define WP_ENVIRONMENT_H
 
-#include "scene.h"
-#include "sampling.h"
+#include "geom/scene.h"
+#include "sampling/warps.h"
 
 #if WP_FEATURE_ENVIRONMENT
 

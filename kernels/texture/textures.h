@@ -18,7 +18,7 @@
 #ifndef WP_TEXTURES_H
 #define WP_TEXTURES_H
 
-#include "scene.h"
+#include "geom/scene.h"
 #include "srgb_lut.h"
 
 /* Texel (x, y) of `img` (both in range) as RGBA in [0, 1], decoded to linear when srgb. */

@@ -9,11 +9,11 @@
 #ifndef WP_MATERIAL_H
 #define WP_MATERIAL_H
 
-#include "bsdf.h"
+#include "bsdf/bsdf.h"
 #include "instance.h"
-#include "ray_cone.h"
+#include "texture/ray_cone.h"
 #include "scene.h"
-#include "textures.h" /* unconditionally: the source expander includes each header once */
+#include "texture/textures.h" /* unconditionally: the source expander includes each header once */
 
 static inline float3 interpolate3(__global const float4* a, uint4 tv, float u, float v) {
   return (1.0f - u - v) * a[tv.x].xyz + u * a[tv.y].xyz + v * a[tv.z].xyz;

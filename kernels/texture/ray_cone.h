@@ -36,8 +36,8 @@
  *               as it was.
  * Why an eighth: the samples of a pixel are already spread over it (box filter) and each scattered
  * sample's neighbours over its lobe, so a cone as wide as a whole footprint blurs the image twice
- * over. Measured on DamagedHelmet seen small (tools/studies/mip_study.py's case, 256 x 256, the model ~50
- * pixels across, 1024 spp): the mip-mapped image converges to a relMSE of 9.3e-5 from the
+ * over. Measured on DamagedHelmet seen small (tools/studies/mip_study.py's case, 256 x 256, the
+ * model ~50 pixels across, 1024 spp): the mip-mapped image converges to a relMSE of 9.3e-5 from the
  * unfiltered one with an eighth (pbrt-v4's smallest scale of its ray differentials too), 2.4e-4
  * with a quarter (0.0064 with whole footprints, measured with the major axis's level), while its
  * relMSE at equal samples stays 1.2-1.75x below the unfiltered render's (docs/performance.md,
@@ -48,8 +48,8 @@
 #ifndef WP_RAY_CONE_H
 #define WP_RAY_CONE_H
 
-#include "elementary.h"
-#include "path_state.h"
+#include "util/elementary.h"
+#include "integrator/path_state.h"
 
 #if WP_FEATURE_TEXTURE_LOD
 /* The cone of the path in `slot` at its ray's origin: x width, y spread angle. */

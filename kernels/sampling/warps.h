@@ -3,8 +3,8 @@
 #ifndef WP_SAMPLING_H
 #define WP_SAMPLING_H
 
-#include "common.h"
-#include "elementary.h"
+#include "util/common.h"
+#include "util/elementary.h"
 
 /* Uniform on the unit disk (Shirley and Chiu's concentric mapping of the square, area-preserving):
  * pdf = 1 / pi. The disk angle is (pi/4) q or pi/2 - (pi/4) q with |q| <= 1, so cos_sin_quarter

@@ -39,8 +39,8 @@
 #ifndef WP_RNG_H
 #define WP_RNG_H
 
-#include "common.h"
-#include "features.h"
+#include "util/common.h"
+#include "util/features.h"
 
 /* Dimensions used at each bounce. */
 #define WP_DIM_PIXEL_X 0u

@@ -17,10 +17,10 @@
 #ifndef WP_LIGHTS_H
 #define WP_LIGHTS_H
 
-#include "common.h"
-#include "alpha.h"
+#include "util/common.h"
+#include "traversal/alpha.h"
 #include "environment.h"
-#include "material.h"
+#include "geom/material.h"
 
 typedef struct LightSample {
   float3 wi;     /* unit direction from the shading point toward the light */

@@ -54,8 +54,8 @@
 #ifndef WP_IRIDESCENCE_H
 #define WP_IRIDESCENCE_H
 
-#include "common.h"
-#include "elementary.h"
+#include "util/common.h"
+#include "util/elementary.h"
 
 /* A film thinner than this fades into the bare base (smoothstep from 0 nm, no film, to here): its
  * optical path 2 n2 d is then at most 40 nm for n2 <= 2, a tenth of the shortest visible

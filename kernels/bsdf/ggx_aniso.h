@@ -1,7 +1,7 @@
 /* Anisotropic GGX for KHR_materials_anisotropy: the normal distribution D, the Smith Lambda, G1
  * and the height-correlated visibility, visible-normal sampling and the density of the reflected
  * direction. Tests: tests/test_anisotropy.cpp (chi-square of the sampling against the pdf,
- * normalisation by quadrature, float64 references, agreement with sampling.h's isotropic GGX).
+ * normalisation by quadrature, float64 references, agreement with warps.h's isotropic GGX).
  *
  * Frame: every direction is a unit vector in the local frame (t, b, n) of the anisotropy: x along
  * the anisotropy direction t (the glTF tangent rotated by anisotropyRotation and the texture's
@@ -13,7 +13,7 @@
  *   Lambda(w) = (sqrt(1 + (ax^2 wx^2 + ay^2 wy^2) / wz^2) - 1) / 2
  *   G1(w)     = 1 / (1 + Lambda(w)),   G2(o, i) = 1 / (1 + Lambda(o) + Lambda(i))
  *
- * With ax == ay == alpha every function is the isotropic one of sampling.h (ggx_d, ggx_g1,
+ * With ax == ay == alpha every function is the isotropic one of sampling/warps.h (ggx_d, ggx_g1,
  * ggx_visibility, sample_ggx_visible_normal, ggx_reflection_pdf) up to float rounding. The
  * sampled normal is the same sequence of operations (bit for bit on PoCL and on NVIDIA's OpenCL),
  * D too up to factors of exactly 1 (bit for bit on PoCL; NVIDIA's compiler fuses its sums into
@@ -24,11 +24,11 @@
  *   by every function. KHR_materials_anisotropy makes lobes that are smooth across and rough
  *   along t (roughness 0, strength > 0: ay = 0), which are no delta lobe; the floor keeps D, its
  *   pdf and the sampler finite there (D <= 1 / (pi ax ay) <= 3.2e5). Below 1e-3 float32 would
- *   lose D's precision anyway (sampling.h, ggx_d), and the isotropic BSDF treats such lobes as
- *   delta lobes, so the reduction to sampling.h holds wherever that code uses GGX.
+ *   lose D's precision anyway (sampling/warps.h, ggx_d), and the isotropic BSDF treats such lobes
+ *   as delta lobes, so the reduction to sampling/warps.h holds wherever that code uses GGX.
  * - grazing: Lambda's wz^2 is floored at 1e-12 as bsdf.h's ggx_lambda does (finite, ~5e5 ax at
  *   wz = 0); G1, the visibility and the pdf are written without 1 / wz, so they are finite at
- *   wz = 0 (G1 = 0, the pdf its grazing limit), where sampling.h's ggx_reflection_pdf is 0/0.
+ *   wz = 0 (G1 = 0, the pdf its grazing limit), where sampling/warps.h's ggx_reflection_pdf is 0/0.
  * - D's denominator is a sum of positive terms (no cancellation near h = n), Lambda is written
  *   as e / (2 (1 + sqrt(1 + e))), not (sqrt(1 + e) - 1) / 2, so its relative error stays a few
  *   ulp where Lambda is small.
@@ -38,7 +38,7 @@
 #ifndef WP_GGX_ANISO_H
 #define WP_GGX_ANISO_H
 
-#include "sampling.h"
+#include "sampling/warps.h"
 
 /* The smallest alpha the functions below use (see the guards above). */
 #define WP_GGX_ANISO_ALPHA_MIN 1e-3f
@@ -101,7 +101,7 @@ static inline float ggx_aniso_visibility(float3 wo, float3 wi, float ax, float a
 /* A microfacet normal h drawn from the normals visible from wo (wo.z >= 0):
  * density D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo.z. Heitz 2018: stretch wo by (ax, ay) to the
  * alpha-1 configuration, sample the projected visible half-disk there, unstretch. Returns a unit
- * h with h.z > 0 (the unstretched z is floored at 1e-7, as sampling.h does). Operation for
+ * h with h.z > 0 (the unstretched z is floored at 1e-7, as sampling/warps.h does). Operation for
  * operation sample_ggx_visible_normal when ax == ay. */
 static inline float3 sample_ggx_aniso_visible_normal(float3 wo, float ax, float ay, float2 u) {
   ax = ggx_aniso_floor(ax), ay = ggx_aniso_floor(ay);
