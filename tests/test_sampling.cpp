@@ -682,7 +682,7 @@ TEST(Sampling, Atan2Poly) {
 // relative; Taylor and series remainders as that header gives them), and its special values. The
 // derivations take division as correctly rounded, as on PoCL's CPU devices; OpenCL allows a
 // device 2.5 ulp there, which could exceed them (on a lent NVIDIA H200 the measured errors stayed
-// within them: docs/performance.md, "Both on an NVIDIA H200").
+// within them: docs/performance.md, "On an NVIDIA H200").
 class Elementary : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { h_ = new wp::test::KernelHarness({"trig_kernels.cl"}); }
