@@ -2,6 +2,7 @@
 // on its own, with nothing but what it includes, and defines exactly its stage's kernel; and no
 // kernel file reaches a path-state lane except through the accessors path_state.h generates from
 // shared/path_state.def.
+#include <cstdlib>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -139,6 +140,77 @@ TEST(KernelSources, EveryStageHasItsFiles) {
   for (const char* header : {"shade_surface", "sample_lights", "sample_bsdf", "roulette_compact"})
     EXPECT_NE(fused.find(std::string("#line 1 \"integrator/") + header + ".h\""), std::string::npos)
         << header;
+}
+
+// Every header is include-guarded: its first directive opens `#ifndef X` `#define X` and its last
+// closes it. The expander leaves out a header already read (kernel_sources.h), which is what the
+// preprocessor would do only because of the guard.
+TEST(KernelSources, EveryHeaderIsIncludeGuarded) {
+  const std::regex guard(R"(^\s*#\s*ifndef\s+(\w+)\s*\n\s*#\s*define\s+(\w+))");
+  int headers = 0;
+  for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
+    const std::string name = f.name;
+    if (name.size() < 2 || name.compare(name.size() - 2, 2, ".h") != 0) continue;
+    ++headers;
+    const std::string text = without_comments(f.text);
+    const std::size_t first = text.find('#');
+    std::smatch m;
+    const std::string head = first == std::string::npos ? "" : text.substr(first);
+    ASSERT_TRUE(std::regex_search(head, m, guard, std::regex_constants::match_continuous))
+        << name << ": no #ifndef/#define guard as its first directive";
+    EXPECT_EQ(m[1], m[2]) << name;
+    const std::size_t last = text.find_last_of('#');
+    EXPECT_EQ(text.compare(last, 6, "#endif"), 0) << name << ": the guard's #endif is not last";
+  }
+  EXPECT_GT(headers, 20);
+}
+
+// The expander reads includes as the preprocessor does: a header included first inside an #if
+// (here one that is false) is pasted again where it is next included, and its guard decides; one
+// already read outside any #if is not pasted twice; an X-macro list (.def) at every include.
+TEST(KernelSources, IncludesBehaveAsThePreprocessorSays) {
+  wp::KernelSources sources;
+  static const std::vector<wp::EmbeddedFile> files = {
+      {"probe/guarded.h",
+       "#ifndef PROBE_GUARDED_H\n#define PROBE_GUARDED_H\nint guarded;\n#endif\n"},
+      {"probe/list.def", "ITEM(one)\n"},
+      {"probe/after_false_if.cl",
+       "#if 0\n#include \"guarded.h\"\n#endif\n#include \"guarded.h\"\n"},
+      {"probe/twice.cl", "#include \"guarded.h\"\n#include \"probe/guarded.h\"\n"},
+      {"probe/lists.cl", "#include \"list.def\"\n#include \"list.def\"\n"},
+  };
+  sources.add(files);
+  const auto count = [](const std::string& text, const std::string& what) {
+    int n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+      ++n;
+    return n;
+  };
+  EXPECT_EQ(count(sources.expand({"probe/after_false_if.cl"}), "int guarded;"), 2);
+  EXPECT_EQ(count(sources.expand({"probe/twice.cl"}), "int guarded;"), 1);
+  EXPECT_EQ(count(sources.expand({"probe/lists.cl"}), "ITEM(one)"), 2);
+  // A header that the first program pasted conditionally only: the second still gets it.
+  EXPECT_EQ(count(sources.expand({"probe/after_false_if.cl", "probe/twice.cl"}), "int guarded;"),
+            2);
+}
+
+// A stock OpenCL C compiler builds each stage file from the source tree, with `-I kernels` and
+// its own #include (clang, as tools/gpu_compile.py uses it; PoCL's own compiler is clang too,
+// but is given the expanded source): the tree reads as ordinary C. Syntax and semantics only,
+// every feature on and AOVs, for the SPIR target (no device's code generator needed).
+TEST(KernelSources, EachStageBuildsWithClangFromTheSourceTree) {
+  if (std::system("clang --version > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "clang not found (tools/setup.sh installs it)";
+  for (const char* name : wp::kStageNames) {
+    SCOPED_TRACE(name);
+    const std::string kernels = std::string(WP_SOURCE_DIR) + "/kernels";
+    const std::string cmd =
+        "clang -x cl -cl-std=CL1.2 -Xclang -finclude-default-header "
+        "-D__OPENCL_VERSION__=120 -D WP_AOV=1 -target spir64 -fsyntax-only "
+        "-Werror -Wall -I '" +
+        kernels + "' '" + kernels + "/" + name + ".cl' 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  }
 }
 
 }  // namespace

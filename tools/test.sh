@@ -66,6 +66,7 @@ else
       fuzz_*) why="clang++ with libFuzzer: tools/setup.sh, and WP_FUZZ_SECONDS not 0" ;;
       gpu_compile) why="clang's GPU targets, libclc and the CUDA toolkit's ptxas" ;;
       Mpi.*) why="Open MPI: tools/setup.sh" ;;
+      KernelSources.EachStageBuildsWithClang*) why="clang: tools/setup.sh" ;;
       vectorization_py | simd_probe_py) why="PoCL as the default OpenCL device" ;;
       *) why="the shared models: ../shared/assets or WAVEPATH_ASSETS" ;;
     esac

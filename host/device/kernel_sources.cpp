@@ -1,6 +1,7 @@
 #include "host/device/kernel_sources.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -42,37 +43,59 @@ static bool exists(const std::vector<std::pair<std::string, std::string>>& files
   return std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.first == name; });
 }
 
-void KernelSources::expand_into(const std::string& name, std::vector<std::string>& done,
-                                std::string& out, int depth) const {
+// Whether `line` opens (#if, #ifdef, #ifndef) or closes (#endif) a conditional block: +1, -1, or 0.
+static int conditional_step(const std::string& line) {
+  std::size_t i = line.find_first_not_of(" \t");
+  if (i == std::string::npos || line[i] != '#') return 0;
+  i = line.find_first_not_of(" \t", i + 1);
+  if (i == std::string::npos) return 0;
+  const auto word = [&](const char* w) {
+    const std::size_t n = std::char_traits<char>::length(w);
+    return line.compare(i, n, w) == 0 &&
+           (i + n == line.size() || !std::isalnum(static_cast<unsigned char>(line[i + n])));
+  };
+  if (word("if") || word("ifdef") || word("ifndef")) return 1;
+  if (word("endif")) return -1;
+  return 0;
+}
+
+void KernelSources::expand_into(const std::string& name, bool conditional,
+                                std::vector<std::string>& done, std::string& out, int depth) const {
   if (depth > 32) throw Error("kernel include nesting too deep at " + name);
-  // X-macro lists (.def) are meant to be expanded at every include; everything else once.
-  const bool once = name.size() < 4 || name.compare(name.size() - 4, 4, ".def") != 0;
-  if (once && std::find(done.begin(), done.end(), name) != done.end()) return;
-  if (once) done.push_back(name);
+  const bool def = name.size() >= 4 && name.compare(name.size() - 4, 4, ".def") == 0;
+  const bool header = name.size() >= 2 && name.compare(name.size() - 2, 2, ".h") == 0;
+  if (!def && std::find(done.begin(), done.end(), name) != done.end()) return;
+  // Pasted where the preprocessor certainly reads it: its guard is defined from here on.
+  if (!def && !conditional) done.push_back(name);
   const std::string text = text_of(name);
   if (text.empty()) throw Error("kernel source not found: " + name);
 
   std::istringstream lines(text);
   std::string line;
   int number = 0;
+  int open = 0;        // conditional blocks open at this line
+  int guard_open = 0;  // a header's own include guard: the first block it opens
   out += "#line 1 \"" + name + "\"\n";
   while (std::getline(lines, line)) {
     ++number;
+    const int step = conditional_step(line);
+    if (step > 0 && header && guard_open == 0 && open == 0) guard_open = 1;
+    open += step;
     const auto first = line.find_first_not_of(" \t");
     // `#include "file"` is expanded; `#include <...>` (only in C++ branches of shared headers,
     // which OpenCL C skips) is kept as it is.
     if (first != std::string::npos && line.compare(first, 8, "#include") == 0 &&
         line.find('<', first) == std::string::npos) {
-      const auto open = line.find('"', first);
-      const auto close = open == std::string::npos ? open : line.find('"', open + 1);
+      const auto quote = line.find('"', first);
+      const auto close = quote == std::string::npos ? quote : line.find('"', quote + 1);
       if (close == std::string::npos)
         throw Error(name + ":" + std::to_string(number) + ": only #include \"file\" is supported");
-      const std::string inc = line.substr(open + 1, close - open - 1);
+      const std::string inc = line.substr(quote + 1, close - quote - 1);
       std::string resolved = folder_of(name) + inc;
       if (!exists(files_, resolved)) resolved = inc;
       if (!exists(files_, resolved))
         throw Error(name + ":" + std::to_string(number) + ": kernel include not found: " + inc);
-      expand_into(resolved, done, out, depth + 1);
+      expand_into(resolved, conditional || def || open > guard_open, done, out, depth + 1);
       out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
       continue;
     }
@@ -84,7 +107,7 @@ void KernelSources::expand_into(const std::string& name, std::vector<std::string
 std::string KernelSources::expand(const std::vector<std::string>& names) const {
   std::vector<std::string> done;
   std::string out;
-  for (const auto& n : names) expand_into(n, done, out, 0);
+  for (const auto& n : names) expand_into(n, false, done, out, 0);
   return out;
 }
 

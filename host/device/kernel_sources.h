@@ -16,9 +16,12 @@ struct EmbeddedFile {
 const std::vector<EmbeddedFile>& core_kernel_sources();
 
 // A set of named sources that `#include "name"` lines resolve against: first relative to the
-// including file's folder, then from the root. Each header is expanded at most once per program
-// (they are include-guarded anyway; this keeps the program text small), an X-macro list (.def)
-// at every include.
+// including file's folder, then from the root, as a compiler given `-I kernels` reads them. The
+// expansion is what the preprocessor would see: every header is include-guarded (the kernel tree
+// test checks), so a header already pasted where it was certain to be read (outside any #if but
+// its own guard, in a file so read) is left out of later includes; one included inside an #if,
+// or in a file itself included inside one, is pasted at each such include and its guard decides,
+// as does everything an X-macro list (.def) includes: a .def is pasted at every include.
 class KernelSources {
  public:
   // The core kernels; with WAVEPATH_KERNEL_DIR set, read from that folder on disk instead.
@@ -31,8 +34,8 @@ class KernelSources {
 
  private:
   std::string text_of(const std::string& name) const;
-  void expand_into(const std::string& name, std::vector<std::string>& done, std::string& out,
-                   int depth) const;
+  void expand_into(const std::string& name, bool conditional, std::vector<std::string>& done,
+                   std::string& out, int depth) const;
   std::vector<std::pair<std::string, std::string>> files_;
   std::string disk_root_;
 };

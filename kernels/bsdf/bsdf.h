@@ -69,8 +69,7 @@
 
 #include "util/common.h"
 #include "sampling/warps.h"
-/* The extensions' pieces; included whatever the features (the source expander takes each header
- * once), used only where their feature is on. */
+/* The extensions' pieces, whatever the features: each is used only where its feature is on. */
 #include "ggx_aniso.h"
 #include "iridescence.h"
 #include "sheen.h"

@@ -13,7 +13,7 @@
 #include "instance.h"
 #include "texture/ray_cone.h"
 #include "scene.h"
-#include "texture/textures.h" /* unconditionally: the source expander includes each header once */
+#include "texture/textures.h"
 
 static inline float3 interpolate3(__global const float4* a, uint4 tv, float u, float v) {
   return (1.0f - u - v) * a[tv.x].xyz + u * a[tv.y].xyz + v * a[tv.z].xyz;

@@ -10,7 +10,7 @@
 
 #include "sampling/rng.h"
 #include "geom/scene.h"
-#include "texture/textures.h" /* unconditionally: the source expander includes each header once */
+#include "texture/textures.h"
 
 /* The material alpha of triangle `tri` at barycentrics (u, v) of its vertices 1 and 2. */
 static inline float material_alpha(const SceneView* scene, uint tri, float u, float v) {

@@ -154,8 +154,8 @@ static inline bool leaf_test(const SceneView* scene, const TraceRay* r, int ref,
 #define WP_WALK_NAME mesh_walk
 #define WP_WALK_LEAF leaf8_test
 #include "traverse8_walk.def"
-/* Here rather than in the stages that use it (WP_SHADOW_PACKET, WP_CLOSEST_PACKET): the host
- * expands each header at its first #include whatever #if it stands in (kernel_sources.cpp). */
+/* The walks of eight rays at once, for the stages built with WP_SHADOW_PACKET or
+ * WP_CLOSEST_PACKET. */
 #include "traverse8_packet.h"
 #else
 #define WP_WALK_NAME mesh_walk
