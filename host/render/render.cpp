@@ -217,11 +217,6 @@ void check_state_memory(const StateMemory& memory, const RenderSettings& setting
                 " of " + device.name + " (CL_DEVICE_GLOBAL_MEM_SIZE)");
 }
 
-int bvh_width(const DeviceEntry& device, const RenderSettings& settings) {
-  if (settings.bvh_width) return settings.bvh_width;
-  return device.gpu ? 2 : 8;
-}
-
 namespace {
 
 // The scene's BVH for `runtime`'s device, from the cache where allowed. A scene too large for the
@@ -229,12 +224,11 @@ namespace {
 // millions of triangles), with the least BVH its triangles need, and again before a fresh build is
 // cached, with the BVH built.
 bvh::Bvh scene_bvh(ClRuntime& runtime, const Scene& scene, const RenderSettings& settings,
-                   const RenderOptions& options, const bvh::BuildOptions& bvh_options,
-                   bool* cached) {
-  const SceneFeatures features = render_features(scene, settings);
-  SceneCounts counts = scene_counts(scene, settings.environment.get(), features.texture_lod);
-  counts.vertex_arrays = VertexArrays::of(features);
-  const std::uint64_t max_buffer = scene_buffer_limit(runtime.device(), settings);
+                   const RenderPlan& plan, const RenderOptions& options,
+                   const bvh::BuildOptions& bvh_options, bool* cached) {
+  SceneCounts counts = scene_counts(scene, settings.environment.get(), plan.features.texture_lod);
+  counts.vertex_arrays = VertexArrays::of(plan.features);
+  const std::uint64_t max_buffer = plan.scene_buffer_limit;
   check_scene_memory(
       scene_layout(counts, min_bvh_bytes(counts.triangles, bvh_options.width), max_buffer)
           .total_bytes(),
@@ -402,10 +396,11 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
                       const RenderSettings& settings, const RenderOptions& options) {
   validate(settings);
   const auto start = std::chrono::steady_clock::now();
+  // The options resolved once for this device and scene (plan.h); completed for the BVH below.
+  RenderPlan plan = plan_render(runtime.device(), scene, settings);
   bvh::BuildOptions bvh_options = options.bvh;
-  bvh_options.width = bvh_width(runtime.device(), settings);
-  check_state_memory(state_memory(settings, render_features(scene, settings), &runtime.device()),
-                     settings, runtime.device());
+  bvh_options.width = plan.bvh_width;
+  check_state_memory(plan.memory, settings, runtime.device());
   const auto step = [&](const std::string& what) {
     if (options.setup_step) options.setup_step(what);
   };
@@ -414,15 +409,17 @@ Rendered render_scene(ClRuntime& runtime, const Scene& scene, Scene* owned,
        (scene.instances.empty() ? std::string()
                                 : " in " + std::to_string(scene.instances.size()) + " instances"));
   bool cached = false;
-  bvh::Bvh bvh = scene_bvh(runtime, scene, settings, options, bvh_options, &cached);
+  bvh::Bvh bvh = scene_bvh(runtime, scene, settings, plan, options, bvh_options, &cached);
+  plan_program(plan, settings, bvh);
   step("packing the scene and building the kernels");
   Rendered out;
   RenderReport& r = out.report;
   report_scene(r, scene, bvh, cached);
   // From here on, with `owned`, the scene's geometry and the BVH's arrays are gone (render_key
   // reads neither).
-  Wavefront wavefront = owned ? Wavefront(runtime, *owned, bvh, settings, HostArrays::kRelease)
-                              : Wavefront(runtime, scene, bvh, settings);
+  Wavefront wavefront =
+      owned ? Wavefront(runtime, *owned, bvh, settings, std::move(plan), HostArrays::kRelease)
+            : Wavefront(runtime, scene, bvh, settings, std::move(plan));
   report_setup(r, runtime, wavefront);
   r.setup_seconds = since(start);
   FilmInfo info;

@@ -179,8 +179,4 @@ void check_state_memory(const StateMemory& memory, const RenderSettings& setting
 // Checks the ranges of user-facing settings; throws wp::Error naming the option.
 void validate(const RenderSettings& settings);
 
-// The BVH layout for `device`: settings.bvh_width if set, else 2 (binary, both child boxes in the
-// parent) on GPUs and 8 (wide, float8 box tests) on CPUs.
-int bvh_width(const DeviceEntry& device, const RenderSettings& settings);
-
 }  // namespace wp

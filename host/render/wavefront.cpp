@@ -29,27 +29,6 @@ const char* sampler_name(Sampler s) {
 
 namespace {
 
-// The one place where program build options are assembled: the scene's features and the
-// settings that are compile-time constants of the kernels.
-std::string program_options(const SceneFeatures& features, const RenderSettings& s, int bvh_width,
-                            std::size_t group_size, bool prefetch) {
-  std::string o = "-cl-std=CL1.2 -D WP_BVH_WIDTH=" + std::to_string(bvh_width);
-  if (features.instances) o += " -D WP_BVH_INSTANCES=1";
-  o += " -D WP_GROUP_SIZE=" + std::to_string(group_size);
-  if (prefetch) o += " -D WP_PREFETCH=1";
-  for (const auto& [name, on] : features.flags()) o += " -D " + name + "=" + (on ? "1" : "0");
-  o += std::string(" -D WP_MIS_POWER=") + (s.mis_heuristic == MisHeuristic::kPower ? "1" : "0");
-  // kernels/util/features.h's WP_SAMPLER_INDEPENDENT, _SOBOL and _SOBOL_PADDED.
-  o += std::string(" -D WP_SAMPLER=") + (s.sampler == Sampler::kIndependent ? "0"
-                                         : s.sampler == Sampler::kSobol     ? "1"
-                                                                            : "2");
-  if (s.aov) o += " -D WP_AOV=1";
-  if (s.view.aperture > 0.0f) o += " -D WP_THIN_LENS=1";
-  // Only with a map and bilinear lookup, so that nearest programs stay as they were.
-  if (features.environment && s.env_filter == EnvFilter::kBilinear) o += " -D WP_ENV_BILINEAR=1";
-  return o;
-}
-
 // The source of a program holding the kernels of `stages`.
 std::string program_source(const std::vector<Stage>& stages) {
   std::vector<std::string> files;
@@ -70,93 +49,29 @@ const dev::Camera pick_camera(const Scene& scene, const RenderSettings& s) {
 
 }  // namespace
 
-std::uint64_t scene_buffer_limit(const DeviceEntry& device, const RenderSettings& settings) {
-  if (settings.scene_buffer_bytes) return settings.scene_buffer_bytes;
-  return device.max_alloc ? device.max_alloc : kSceneBufferReach;
-}
-
-WaveShape wave_shape(const RenderSettings& settings, std::size_t auto_paths) {
-  const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
-  const std::size_t size = settings.wave_size ? settings.wave_size : auto_paths;
-  WaveShape wave;
-  if (!settings.wave_size && auto_paths && pixels > auto_paths) {
-    // The nearest whole number of waves of auto_paths, the pixels spread evenly over them: no
-    // short last wave paying a whole wave's launches, and an image up to 1.5 waves in one.
-    const std::size_t waves = std::max<std::size_t>(1, (pixels + auto_paths / 2) / auto_paths);
-    wave.pixels = (pixels + waves - 1) / waves;
-    return wave;
-  }
-  wave.pixels = std::min(pixels, size ? size : std::size_t(1) << 20);
-  const std::size_t multi = size ? size : kMultiSamplePaths;
-  wave.samples = std::max<std::size_t>(1, multi / wave.pixels);
-  return wave;
-}
-
-std::size_t auto_wave_paths(const DeviceEntry* device, std::size_t bytes_per_path) {
-  if (!device || device->gpu || device->cache_bytes == 0 || bytes_per_path == 0) return 0;
-  const std::size_t fit = static_cast<std::size_t>(device->cache_bytes / bytes_per_path);
-  std::size_t paths = std::size_t(1) << 16;
-  while (paths < (std::size_t(1) << 20) && paths * 2 <= fit) paths *= 2;
-  return paths;
-}
-
-std::size_t environment_wave_size() {
-  const char* text = std::getenv("WAVEPATH_WAVE_SIZE");
-  if (!text || !*text) return 0;
-  char* end = nullptr;
-  const unsigned long long size = std::strtoull(text, &end, 10);
-  if (*end != '\0' || text[0] == '-' || size == 0 || size > kMaxWaveSize)
-    throw Error(std::string("WAVEPATH_WAVE_SIZE=") + text + ": must be a whole number from 1 to " +
-                std::to_string(kMaxWaveSize));
-  return static_cast<std::size_t>(size);
-}
-
-StateMemory state_memory(const RenderSettings& settings, const SceneFeatures& features,
-                         const DeviceEntry* device) {
-  StateMemory m;
-  const std::size_t per_path =
-      path_state_layout(1, settings.aov, features, settings.fused).bytes_per_path +
-      WP_QUEUE_COUNT * sizeof(dev::uint);
-  if (!settings.wave_size) {
-    if (const std::size_t forced = environment_wave_size()) {
-      RenderSettings with_wave = settings;
-      with_wave.wave_size = forced;
-      m.wave = wave_shape(with_wave);
-    }
-  }
-  if (!m.wave.pixels) m.wave = wave_shape(settings, auto_wave_paths(device, per_path));
-  m.path_state = path_state_layout(m.wave.paths(), settings.aov, features, settings.fused);
-  m.queues = std::uint64_t(WP_QUEUE_COUNT) * m.wave.paths() * sizeof(dev::uint);
-  m.counters = WP_COUNTER_COUNT * sizeof(dev::uint);
-  const std::uint64_t pixels = std::uint64_t(settings.width) * std::uint64_t(settings.height);
-  m.film = pixels * WP_FILM_WORDS(settings.aov) * sizeof(std::uint64_t);
-  return m;
-}
-
-SceneFeatures render_features(const Scene& scene, const RenderSettings& settings) {
-  SceneFeatures f = settings.all_features
-                        ? SceneFeatures::all()
-                        : SceneFeatures::of(scene, settings.environment != nullptr);
-  if (!settings.mipmaps) f.texture_lod = false;
-  f.instances = !scene.instances.empty();
-  return f;
-}
-
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings)
-    : Wavefront(runtime, scene, bvh, settings, nullptr, nullptr) {}
+    : Wavefront(runtime, scene, bvh, settings, plan_render(runtime.device(), scene, settings),
+                nullptr, nullptr) {}
+
+Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
+                     const RenderSettings& settings, RenderPlan plan)
+    : Wavefront(runtime, scene, bvh, settings, std::move(plan), nullptr, nullptr) {}
 
 Wavefront::Wavefront(ClRuntime& runtime, Scene& scene, bvh::Bvh& bvh,
-                     const RenderSettings& settings, HostArrays host)
-    : Wavefront(runtime, scene, bvh, settings, host == HostArrays::kRelease ? &scene : nullptr,
+                     const RenderSettings& settings, RenderPlan plan, HostArrays host)
+    : Wavefront(runtime, scene, bvh, settings, std::move(plan),
+                host == HostArrays::kRelease ? &scene : nullptr,
                 host == HostArrays::kRelease ? &bvh : nullptr) {}
 
 Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh,
-                     const RenderSettings& settings, Scene* owned_scene, bvh::Bvh* owned_bvh)
-    : rt_(runtime), settings_(settings), pipeline_(pipeline(settings.fused)) {
-  // An explicit work-group size always: left to itself, PoCL picks one per global size (a divisor
-  // of it) and compiles every kernel again for each new one, seconds each time.
-  local_size_ = settings.local_size ? settings.local_size : 64;
+                     const RenderSettings& settings, RenderPlan plan, Scene* owned_scene,
+                     bvh::Bvh* owned_bvh)
+    : rt_(runtime),
+      settings_(settings),
+      pipeline_(pipeline(settings.fused)),
+      plan_(std::move(plan)) {
+  if (plan_.program_options.empty()) plan_program(plan_, settings, bvh);
   // Tables built for the other filter (a map made with the default of build_environment_tables):
   // a copy with tables for this one, kept in settings_ for the upload.
   if (settings_.environment && settings_.environment->filter != settings_.env_filter) {
@@ -165,48 +80,6 @@ Wavefront::Wavefront(ClRuntime& runtime, const Scene& scene, const bvh::Bvh& bvh
     settings_.environment = std::move(rebuilt);
   }
   const EnvironmentMap* env = settings_.environment.get();
-  features_ = render_features(scene, settings);
-  // Cache hints in the stages that read path state through a queue (kernels/util/features.h,
-  // WP_PREFETCH): on PoCL's CPU devices, where clang's __builtin_prefetch becomes a prefetch
-  // instruction and every address space is one.
-  const DeviceEntry& device = rt_.device();
-  const bool pocl_cpu = !device.gpu && device.platform_name == "Portable Computing Language";
-  const bool prefetch = settings.prefetch && pocl_cpu;
-  options_ = program_options(features_, settings, bvh.width, local_size_, prefetch);
-  // Rays eight to a work-item (kernels/traversal/traverse8_packet.h) on the wide layout without
-  // instances or alpha: shadow rays where they are plain any-hit queries (no transmission),
-  // closest-hit rays always there. Only on PoCL's CPU devices, where it was measured
-  // (docs/performance.md, "Shadow rays in packets of eight", "Closest-hit rays in packets"), unless
-  // the settings force them (the Oclgrind tests). The same image either way.
-  const bool packets_here = pocl_cpu || settings.force_packets;
-  const bool packets = packets_here && bvh.width == 8 && !features_.instances && !features_.alpha;
-  shadow_packet_ = settings.shadow_packets && packets && !features_.transmission ? 8u : 1u;
-  closest_packet_ = settings.closest_packets && packets ? 8u : 1u;
-  if (shadow_packet_ > 1) options_ += " -D WP_SHADOW_PACKET=1";
-  if (closest_packet_ > 1) options_ += " -D WP_CLOSEST_PACKET=1";
-  // In a scene of a few large triangles (at most kMaskedClosestBlocks blocks of four: the Cornell
-  // box's kind) every packet reaches most triangles and whether any lane lies inside one is a coin
-  // toss, so the closest-hit packet takes each triangle's lanes by mask instead of branching on
-  // that; on a dense mesh the branch is predictable and skips the division (docs/performance.md,
-  // "Closest-hit packets without a branch per triangle"). The same hits either way.
-  constexpr std::size_t kMaskedClosestBlocks = 64;
-  if (closest_packet_ > 1 && bvh.blocks.size() <= kMaskedClosestBlocks)
-    options_ += " -D WP_PACKET_MASKED_CLOSEST=1";
-  // Shading eight paths per work-item, float8 lanes being paths, where every scattering surface
-  // is Lambertian and untextured (kernels/integrator/shade_packet.h says what it needs).
-  const SceneFeatures& f = features_;
-  const bool lambertian = !f.glossy && !f.textures && !f.texture_lod && !f.normal_maps &&
-                          !f.vertex_colors && !f.alpha && !f.unlit && !f.transmission &&
-                          !f.volume && !f.specular && !f.clearcoat && !f.sheen && !f.anisotropy &&
-                          !f.iridescence && !f.diffuse_transmission && !f.dispersion &&
-                          !f.instances;
-  shade_packet_ = settings.shade_packets && packets_here && lambertian && !settings.aov ? 8u : 1u;
-  if (shade_packet_ > 1) options_ += " -D WP_SHADE_PACKET=1";
-  const bool forced = !pocl_cpu && (shade_packet_ > 1 || shadow_packet_ > 1 || closest_packet_ > 1);
-  if (forced) options_ += " -D WP_PACKETS_FORCED=1";
-  memory_ = state_memory(settings, features_, &device);
-  wave_size_ = memory_.wave.pixels;
-  samples_per_wave_ = memory_.wave.samples;
   lights_ = build_light_table(scene, env, settings.background, settings.env_intensity,
                               settings.light_select);
   try {
@@ -227,12 +100,12 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh, Scene* owned_sce
   extras.env_intensity = settings_.env_intensity;
   extras.env_rotation_degrees = settings_.env_rotation;
   extras.lights = &lights_;
-  extras.mipmaps = features_.texture_lod;
-  extras.vertex_arrays = VertexArrays::of(features_);
+  extras.mipmaps = plan_.features.texture_lod;
+  extras.vertex_arrays = VertexArrays::of(plan_.features);
   // On a CPU device the kernels read the packed scene in place, which therefore stays here; a GPU
   // gets its own copy, and the host's goes at the end of this function.
   const bool in_place = !rt_.device().gpu;
-  const std::uint64_t max_buffer = scene_buffer_limit(rt_.device(), settings_);
+  const std::uint64_t max_buffer = plan_.scene_buffer_limit;
   PackedScene packed = owned_scene && owned_bvh ? pack_scene(*owned_scene, *owned_bvh, extras,
                                                              max_buffer, HostArrays::kRelease)
                                                 : pack_scene(scene, bvh, extras, max_buffer);
@@ -247,18 +120,18 @@ void Wavefront::upload(const Scene& scene, const bvh::Bvh& bvh, Scene* owned_sce
     char map[64];
     std::snprintf(map, sizeof(map), " -D WP_SCENE_BUFFER_MAP=0x%llxul",
                   static_cast<unsigned long long>(packed.buffer_map));
-    options_ += map;
+    plan_.program_options += map;
   }
   if (in_place) packed_ = std::move(packed.buffers);
 }
 
 void Wavefront::allocate_state() {
   const cl::Context& ctx = rt_.context();
-  path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.path_state.bytes);
-  queue_slots_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.queues);
-  counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.counters);
-  const std::size_t film_words = memory_.film / sizeof(std::uint64_t);
-  film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, memory_.film);
+  path_buf_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, plan_.memory.path_state.bytes);
+  queue_slots_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, plan_.memory.queues);
+  counters_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, plan_.memory.counters);
+  const std::size_t film_words = plan_.memory.film / sizeof(std::uint64_t);
+  film_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, plan_.memory.film);
   // Zeroed by one write of host zeros over the whole buffer, not clEnqueueFillBuffer: Oclgrind
   // 21.10 (tests/test_oclgrind.sh) re-creates a buffer's whole initialisation state at every host
   // write, sized to that write, so a fill (stored one pattern at a time) or a partial write leaves
@@ -291,7 +164,8 @@ void Wavefront::build_program() {
   const std::string all = program_source(all_stages());
   source_digest_ = fnv1a64(all.data(), all.size());
   program_stages_ = pipeline_.stages();
-  program_ = rt_.build(program_source(program_stages_), options_, settings_.kernel_cache_dir);
+  program_ =
+      rt_.build(program_source(program_stages_), plan_.program_options, settings_.kernel_cache_dir);
   kernel_cached_ = rt_.cached_build();
   for (const Stage stage : pipeline_.stages()) kernel(stage);
   prime_kernels();
@@ -312,12 +186,13 @@ cl::Kernel& Wavefront::kernel(Stage stage) {
   const bool in_program =
       std::find(program_stages_.begin(), program_stages_.end(), stage) != program_stages_.end();
   if (!in_program && !other_program_())
-    other_program_ = rt_.build(program_source(all_stages()), options_, settings_.kernel_cache_dir);
+    other_program_ =
+        rt_.build(program_source(all_stages()), plan_.program_options, settings_.kernel_cache_dir);
   try {
     k = cl::Kernel(in_program ? program_ : other_program_, stage_name(stage));
     cl_uint arg = set_scene_args(k, 0, scene_);
     k.setArg(arg++, path_buf_);
-    k.setArg(arg++, memory_.path_state.layout);
+    k.setArg(arg++, plan_.memory.path_state.layout);
     k.setArg(arg++, queue_slots_);
     k.setArg(arg++, counters_);
     launch_arg_ = arg++;
@@ -342,7 +217,7 @@ void Wavefront::prime_kernels() {
   p.queue_out = WP_QUEUE_RAY_B;
   try {
     for (const Stage stage : pipeline_.stages())
-      launch(stage, static_cast<std::uint32_t>(local_size_), p);
+      launch(stage, static_cast<std::uint32_t>(plan_.local_size), p);
     rt_.queue().finish();
   } catch (const cl::Error& e) {
     rethrow_cl(e, "preparing the kernels on " + rt_.device().name);
@@ -353,13 +228,13 @@ void Wavefront::prime_kernels() {
 cl::Event Wavefront::launch(Stage stage, std::uint32_t items, const dev::Launch& params) {
   if (items == 0) return cl::Event();
   if (stage == Stage::kTraceShadow) last_shadow_rays_ = items;  // its queue's exact length
-  if (stage == Stage::kTraceShadow && shadow_packet_ > 1 && params.shadow_packet > 1)
-    items = (items + shadow_packet_ - 1) / shadow_packet_;
+  if (stage == Stage::kTraceShadow && plan_.shadow_packet > 1 && params.shadow_packet > 1)
+    items = (items + plan_.shadow_packet - 1) / plan_.shadow_packet;
   if (stage == Stage::kShade || stage == Stage::kGenerateCameraRays)  // eight paths a work-item
-    items = (items + shade_packet_ - 1) / shade_packet_;
-  if (stage == Stage::kIntersectClosest && closest_packet_ > 1 && params.packet > 1)
-    items = (items + closest_packet_ - 1) / closest_packet_;
-  const std::size_t local = local_size_;
+    items = (items + plan_.shade_packet - 1) / plan_.shade_packet;
+  if (stage == Stage::kIntersectClosest && plan_.closest_packet > 1 && params.packet > 1)
+    items = (items + plan_.closest_packet - 1) / plan_.closest_packet;
+  const std::size_t local = plan_.local_size;
   const std::size_t global = local ? (items + local - 1) / local * local : items;
   cl::Kernel& k = kernel(stage);
   cl::Event event;
@@ -410,8 +285,8 @@ dev::Launch Wavefront::launch_params(std::uint32_t sample, std::uint32_t first_p
   p.strategy =
       static_cast<dev::uint>(settings_.strategy);  // WP_STRATEGY_* (kernels/util/features.h)
   // Packets where the program has them; run_wave picks per bounce.
-  p.packet = closest_packet_;
-  p.shadow_packet = shadow_packet_;
+  p.packet = plan_.closest_packet;
+  p.shadow_packet = plan_.shadow_packet;
   return p;
 }
 
@@ -471,14 +346,14 @@ void Wavefront::run_wave(std::uint32_t sample, std::uint32_t first_pixel, std::u
   std::size_t bounce = 0;
   for (std::uint32_t rays = p.path_count; rays > 0; ++bounce) {
     rays_traced_ += rays;
-    const int mode = packet_mode(packet_timing_, closest_packet_, bounce);
-    const int shadow_mode = packet_mode(shadow_timing_, shadow_packet_, bounce);
-    p.packet = mode == 1 ? closest_packet_ : 1u;
-    p.shadow_packet = shadow_mode == 1 ? shadow_packet_ : 1u;
+    const int mode = packet_mode(packet_timing_, plan_.closest_packet, bounce);
+    const int shadow_mode = packet_mode(shadow_timing_, plan_.shadow_packet, bounce);
+    p.packet = mode == 1 ? plan_.closest_packet : 1u;
+    p.shadow_packet = shadow_mode == 1 ? plan_.shadow_packet : 1u;
     const std::uint32_t traced = rays;
     rays = run_bounce(p, rays, static_cast<int>(bounce));
-    time_packets(packet_timing_, closest_packet_, last_intersect_, bounce, mode, traced);
-    time_packets(shadow_timing_, shadow_packet_, last_shadow_, bounce, shadow_mode,
+    time_packets(packet_timing_, plan_.closest_packet, last_intersect_, bounce, mode, traced);
+    time_packets(shadow_timing_, plan_.shadow_packet, last_shadow_, bounce, shadow_mode,
                  last_shadow_rays_);
   }
   ++waves_run_;
@@ -535,12 +410,12 @@ std::uint32_t Wavefront::shadow_ahead_items(const dev::Launch& p, std::uint32_t 
   if (bounce < 0 || !(settings_.shadow_ahead > 0.0f)) return 0;
   const std::size_t b = static_cast<std::size_t>(bounce);
   if (b >= shadow_share_.size() || shadow_share_[b] < 0.0) return 0;
-  if (shadow_packet_ > 1) {
+  if (plan_.shadow_packet > 1) {
     const std::size_t t = std::min(b, kPacketTimingBounces - 1);
     if (t >= shadow_timing_.size() || shadow_timing_[t].choice < 0) return 0;
   }
   const std::uint64_t unit =
-      std::uint64_t(local_size_) * (p.shadow_packet > 1 ? shadow_packet_ : 1u);
+      std::uint64_t(plan_.local_size) * (p.shadow_packet > 1 ? plan_.shadow_packet : 1u);
   // At most the bounce's rays (the share is >= 0); a wave's paths are far below 2^32 - unit.
   const double want = std::ceil(shadow_share_[b] * settings_.shadow_ahead * rays);
   const auto items = static_cast<std::uint64_t>(std::min(want, double(rays)));
@@ -613,7 +488,7 @@ std::uint32_t Wavefront::run_bounce(dev::Launch& p, std::uint32_t rays, int boun
 
 Wavefront::Snapshot Wavefront::snapshot() {
   Snapshot s;
-  s.paths.resize(memory_.path_state.bytes);
+  s.paths.resize(plan_.memory.path_state.bytes);
   s.slots.resize(WP_QUEUE_COUNT * wave_paths());
   s.counters.resize(WP_COUNTER_COUNT);
   auto& q = rt_.queue();
@@ -635,13 +510,15 @@ void Wavefront::restore(const Snapshot& s) {
 }
 
 void Wavefront::render_pass(std::uint32_t sample, std::uint32_t samples) {
-  if (samples < 1 || samples > samples_per_wave_)
+  if (samples < 1 || samples > plan_.memory.wave.samples)
     throw Error("render_pass: the samples of a pass must fit one wave");
   const std::uint32_t pixels = static_cast<std::uint32_t>(settings_.width * settings_.height);
   try {
-    for (std::uint32_t first = 0; first < pixels; first += static_cast<std::uint32_t>(wave_size_))
+    for (std::uint32_t first = 0; first < pixels;
+         first += static_cast<std::uint32_t>(plan_.memory.wave.pixels))
       run_wave(sample, first,
-               std::min<std::uint32_t>(static_cast<std::uint32_t>(wave_size_), pixels - first),
+               std::min<std::uint32_t>(static_cast<std::uint32_t>(plan_.memory.wave.pixels),
+                                       pixels - first),
                samples);
     rt_.queue().finish();
   } catch (const cl::Error& e) {
