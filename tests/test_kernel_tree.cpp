@@ -3,6 +3,7 @@
 // kernel file reaches a path-state lane except through the accessors path_state.h generates from
 // shared/path_state.def.
 #include <cstdlib>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -140,6 +141,39 @@ TEST(KernelSources, EveryStageHasItsFiles) {
   for (const char* header : {"shade_surface", "sample_lights", "sample_bsdf", "roulette_compact"})
     EXPECT_NE(fused.find(std::string("#line 1 \"integrator/") + header + ".h\""), std::string::npos)
         << header;
+}
+
+// No function is written twice, one copy for a feature switch and one for its absence: a switch
+// sits inside the one definition, where the lobes or paths are composed (the X-macro walks of
+// traversal/*.def, instantiated per level under names of their own, are not functions here).
+// Forward declarations (a `;` after the parameters) are not definitions.
+TEST(KernelSources, NoFunctionIsDefinedTwice) {
+  const std::regex definition(
+      R"((?:^|\n)(?:static\s+inline|WP_LANES_FN|WP_BSDF_EVAL_INLINE|WP_STAGE_FN))"
+      R"((?:\s+__attribute__\s*\(\([^)]*\)\))?\s[^;{}()]*?)"
+      R"(\b(\w+)\s*\([^;{}]*\)\s*\{)");
+  // The pattern catches what it is meant to (else the test below could pass by matching nothing).
+  const std::string probe =
+      "static inline float f(float x) {\n}\n#if A\nWP_LANES_FN float8 g(float8 x,\n    int y) {}\n"
+      "static inline float h(float x);\nstatic inline __attribute__((always_inline)) int k() {}\n";
+  std::vector<std::string> found;
+  for (std::sregex_iterator it(probe.begin(), probe.end(), definition), end; it != end; ++it)
+    found.push_back((*it)[1]);
+  EXPECT_EQ(found, (std::vector<std::string>{"f", "g", "k"}));
+  std::map<std::string, std::string> where;
+  int definitions = 0;
+  for (const wp::EmbeddedFile& f : wp::core_kernel_sources()) {
+    const std::string name = f.name;
+    if (name.size() > 4 && name.compare(name.size() - 4, 4, ".def") == 0) continue;
+    const std::string text = without_comments(f.text);
+    for (std::sregex_iterator it(text.begin(), text.end(), definition), end; it != end; ++it) {
+      ++definitions;
+      const std::string fn = (*it)[1];
+      const auto [at, fresh] = where.emplace(fn, name);
+      EXPECT_TRUE(fresh) << fn << " is defined in " << at->second << " and again in " << name;
+    }
+  }
+  EXPECT_GT(definitions, 200);
 }
 
 // Every header is include-guarded: its first directive opens `#ifndef X` `#define X` and its last

@@ -111,26 +111,27 @@ static inline uint bf16_from_float(float x) {
 static inline float bf16_to_float(uint h) {
   return as_float(h << 16);
 }
-static inline uint low_half(uint word) {
-  return word & 0xffffu;
-}
-static inline uint with_low_half(uint word, uint low) {
-  return (word & 0xffff0000u) | low;
-}
 static inline float high_bf16(uint word) {
   return bf16_to_float(word >> 16);
 }
 static inline uint with_high_bf16(uint word, float x) {
   return (word & 0xffffu) | (bf16_from_float(x) << 16);
 }
-#else
+#endif
 static inline uint low_half(uint word) {
+#if WP_FEATURE_TEXTURE_LOD
+  return word & 0xffffu;
+#else
   return word;
+#endif
 }
 static inline uint with_low_half(uint word, uint low) {
+#if WP_FEATURE_TEXTURE_LOD
+  return (word & 0xffff0000u) | low;
+#else
   return (void)word, low;
-}
 #endif
+}
 static inline uint path_bounce(Paths paths, uint slot) {
   return low_half(path_bounce_word(paths, slot));
 }

@@ -68,7 +68,7 @@ WP_LANES_FN uint sample_next_ray8(Paths paths, Queues queues, Launch launch, con
                                   float8 u_rr) {
   float8 pdf;
   int8 valid;
-  const Float3x8 wi = bsdf_sample8(s, cos_o, ux, uy, &pdf, &valid);
+  const Float3x8 wi = lambert_sample8(s, cos_o, ux, uy, &pdf, &valid);
   const Float3x8 next = {beta.x * s->color.x, beta.y * s->color.y, beta.z * s->color.z};
   const int8 finite = finite3x8(next) && isfinite(pdf);
   const Float3x8 o = surface_spawn8(s, ray_d, t, wi);

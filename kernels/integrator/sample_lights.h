@@ -70,7 +70,7 @@ WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues q
   }
   ls.pdf *= pmf;
   float8 e_pdf;
-  const Float3x8 f = bsdf_eval8(s, cos_o, ls.wi, &e_pdf);
+  const Float3x8 f = lambert_eval8(s, cos_o, ls.wi, &e_pdf);
   const float8 w = mis_weight_light8(ls.pdf, e_pdf, strategy);
   const float8 k = fabs(dot3x8(s->ns, ls.wi)) * w / ls.pdf;
   const Float3x8 c = {beta.x * f.x * ls.li.x * k, beta.y * f.y * ls.li.y * k,

@@ -126,17 +126,18 @@ static inline float3 env_bilinear(const SceneView* scene, float u, float v) {
   return mix(top, bottom, ty);
 }
 
+#endif
+
 /* The map's radiance at map coordinates uv: the filter's lookup, scaled. */
 static inline float3 env_map_radiance_uv(const SceneView* scene, float2 uv) {
+#if WP_ENV_BILINEAR
   return env_bilinear(scene, uv.x, uv.y) * scene->desc->env_params.x;
-}
 #else
-static inline float3 env_map_radiance_uv(const SceneView* scene, float2 uv) {
   const SceneDesc* d = scene->desc;
   const uint2 t = env_texel_at(d, uv);
   return scene->env_texels[t.y * d->env_width + t.x].xyz * d->env_params.x;
-}
 #endif
+}
 
 /* The density env_map_sample gives the direction at map coordinates uv, where sin(theta) is
  * sin_theta: its texel's (env_texel_at). */

@@ -377,7 +377,7 @@ static inline PairSource rng_pair_source(Rng r, uint dim) {
  * rng_get and rng_get2 are always inlined: clang kept them out of line in the fused shade kernel,
  * where the calls cost a large share of a render on PoCL (docs/performance.md, "Random numbers
  * inlined"). */
-static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
+static inline __attribute__((always_inline)) float rng_sobol_get(Rng r, uint dim) {
   const uint seed = rng_group_seed(r, dim);
   const uint index = rng_owen(r.sample, seed);
   return rng_float(rng_van_der_corput(index, seed));
@@ -387,7 +387,7 @@ static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
  * (rng_pair_source) -- for the first two, the first (van der Corput) and the second (its digits
  * from rng_taylor_shift) -- in the two lanes of a uint2, each with its own key, as rng_bounce does
  * eight at a time: the two chains run side by side in one vector register. */
-static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
+static inline __attribute__((always_inline)) float2 rng_sobol_get2(Rng r, uint dim) {
   const PairSource src = rng_pair_source(r, dim);
   const uint seed = rng_group_seed(r, src.group);
   const uint index = rng_owen(r.sample, seed);
@@ -403,7 +403,7 @@ static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
  * (tested by Rng.BounceDrawEqualsTheOneByOneDraws), computed eight at a time: a CPU runs the lanes
  * in one SIMD register, a quarter of the instructions of seven scalar draws, with the depth of
  * one, so the shading kernel can draw them ahead of the work that needs them (shade.cl). */
-static inline __attribute__((always_inline)) float8 rng_bounce(Rng r) {
+static inline __attribute__((always_inline)) float8 rng_sobol_bounce(Rng r) {
   const PairSource light = rng_pair_source(r, WP_DIM_LIGHT_U);
   const PairSource bsdf = rng_pair_source(r, WP_DIM_BSDF_U);
   uint8 group = WP_BOUNCE_GROUPS, pair = (uint8)(0u);
@@ -519,20 +519,44 @@ WP_LANES_FN void rng_bounce_lanes(RngLanes r, float8* u, bool pick, bool roulett
 
 #else
 
-static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
+static inline __attribute__((always_inline)) float rng_independent_get(Rng r, uint dim) {
   return rng_float(rng_bits(r, dim));
 }
 
-/* As the Sobol' rng_bounce; here a pair's second number is the next dimension's (rng_get2). */
-static inline __attribute__((always_inline)) float8 rng_bounce(Rng r) {
+/* As rng_sobol_bounce; here a pair's second number is the next dimension's (rng_get2). */
+static inline __attribute__((always_inline)) float8 rng_independent_bounce(Rng r) {
   const uint8 dim = WP_BOUNCE_GROUPS - as_uint8(WP_BOUNCE_SECOND); /* -(-1): the pair's next */
   return rng_float8(rng_bits8(r, dim));
 }
 
-static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
-  return (float2)(rng_get(r, dim), rng_get(r, dim + 1u));
+static inline __attribute__((always_inline)) float2 rng_independent_get2(Rng r, uint dim) {
+  return (float2)(rng_independent_get(r, dim), rng_independent_get(r, dim + 1u));
 }
 
 #endif
+
+/* The numbers of the sample pattern the program is built for (WP_SAMPLER): one (rng_get), a pair
+ * of a two-dimensional group (rng_get2), all of a bounce's (rng_bounce, lanes WP_BOUNCE_GROUPS). */
+static inline __attribute__((always_inline)) float rng_get(Rng r, uint dim) {
+#if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
+  return rng_sobol_get(r, dim);
+#else
+  return rng_independent_get(r, dim);
+#endif
+}
+static inline __attribute__((always_inline)) float2 rng_get2(Rng r, uint dim) {
+#if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
+  return rng_sobol_get2(r, dim);
+#else
+  return rng_independent_get2(r, dim);
+#endif
+}
+static inline __attribute__((always_inline)) float8 rng_bounce(Rng r) {
+#if WP_SAMPLER != WP_SAMPLER_INDEPENDENT
+  return rng_sobol_bounce(r);
+#else
+  return rng_independent_bounce(r);
+#endif
+}
 
 #endif /* WP_RNG_H */

@@ -18,23 +18,27 @@
  * (a comparison's lanes are all ones or all zeros); measured in docs/performance.md, "Lane masks
  * in one instruction". any4: whether some lane of a four-lane mask is set, the same way. */
 #if WP_PREFETCH && defined(__AVX__)
-static inline int lane_bits8(int8 m) {
-  return __builtin_ia32_movmskps256(as_float8(m));
-}
-static inline bool any4(int4 m) {
-  return __builtin_ia32_movmskps(as_float4(m)) != 0;
-}
+#define WP_SIGN_MASKS 1
 #else
+#define WP_SIGN_MASKS 0
+#endif
 static inline int lane_bits8(int8 m) {
+#if WP_SIGN_MASKS
+  return __builtin_ia32_movmskps256(as_float8(m));
+#else
   const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
   const int4 b4 = b.lo | b.hi;
   const int2 b2 = b4.lo | b4.hi;
   return b2.x | b2.y;
+#endif
 }
 static inline bool any4(int4 m) {
+#if WP_SIGN_MASKS
+  return __builtin_ia32_movmskps(as_float4(m)) != 0;
+#else
   return any(m);
-}
 #endif
+}
 
 /* Whether some lane (all lanes) of a comparison's mask is set: the sign bits in one instruction,
  * as lane_bits8, where PoCL's any() and all() move the mask to a vector and test the lanes' signs
