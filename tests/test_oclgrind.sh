@@ -209,11 +209,11 @@ canary() {
   is_selected canary || return 0
   matched=$((matched + 1))
   local dir=$work/canary_kernels
-  mkdir -p "$dir"
+  mkdir -p "$dir/integrator"
   sed 's/if (index >= qs\.counters\[q\]) return false;/if (index >= qs.counters[q] + 0u * qs.counters[q + WP_COUNTER_COUNT]) return false;/' \
-    "$src/kernels/queues.h" >"$dir/queues.h"
+    "$src/kernels/integrator/queues.h" >"$dir/integrator/queues.h"
   ran=$((ran + 1))
-  if ! grep -q 'qs.counters\[q + WP_COUNTER_COUNT\]' "$dir/queues.h"; then
+  if ! grep -q 'qs.counters\[q + WP_COUNTER_COUNT\]' "$dir/integrator/queues.h"; then
     failures=$((failures + 1))
     echo "FAIL canary: could not plant the out-of-bounds read (queue_get in kernels/integrator/queues.h changed;"
     echo "     update the sed pattern in $0)"
