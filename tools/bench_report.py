@@ -146,30 +146,26 @@ def end_to_end_rows(scenes):
             return f"skipped: {b.get('error_message', '')}" if b is not None and failed(b) else None
         return cell
 
-    def from_render(text):
+    def of(family, text):
+        """The cell of `family`'s benchmark of a scene, text(benchmark), or None without it."""
         def cell(name):
-            r = good(name, "render")
-            return None if r is None else text(r)
+            b = good(name, family)
+            return None if b is None else text(b)
         return cell
+
+    def from_render(text):
+        return of("render", text)
+
+    def program(text):
+        return of("program_build", text)
+
+    def bvh(text):
+        return of("bvh_build", text)
 
     def share(stage):
         # A split stage has no time in a fused render: a row of zeros is left out.
-        def cell(name):
-            r = good(name, "render")
-            return None if r is None or not r.get(f"share_{stage}") else percent(r[f"share_{stage}"])
-        return cell
-
-    def program(text):
-        def cell(name):
-            p = good(name, "program_build")
-            return None if p is None else text(p)
-        return cell
-
-    def bvh(text):
-        def cell(name):
-            v = good(name, "bvh_build")
-            return None if v is None else text(v)
-        return cell
+        key = f"share_{stage}"
+        return from_render(lambda r: percent(r[key]) if r.get(key) else None)
 
     specs = [(family, skipped(family)) for family in END_TO_END]
     specs.append(("samples/s (whole passes)", from_render(
