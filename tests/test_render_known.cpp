@@ -748,16 +748,80 @@ void expect_packets_match_single_paths(wp::ClRuntime& runtime, const wp::Scene& 
   }
 }
 
-// In a scene of untextured Lambertian surfaces the fused kernel shades eight paths per work-item
-// on PoCL's CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path
-// kernel's bit for bit, with every kind of light sample (the lamp's triangles and the constant
-// background in SIMD lanes, the point light by the single-path function), each sampler and
-// strategy, and several waves of different sizes (which paths share a packet changes nothing).
-// The default suite takes Sobol' under MIS; ...Exhaustive (slow) each sampler and strategy.
+// The busy scene with glTF's metallic-roughness BSDF everywhere (WP_BSDF_PLAIN): the glossy sphere
+// (metallic 0.5, roughness 0.3), the smooth mirror (a delta lobe: its paths are shaded one at a
+// time), a dielectric floor with specular factor 0.5 and ior 1 (F0 0), and small spheres of
+// roughness just below and above the delta threshold (alpha = roughness^2 against WP_DELTA_ALPHA
+// 1e-3: roughness 0.0316 and 0.0317) and of ior 3 with specular 1, so that the lanes mix every
+// kind.
+wp::Scene glossy_busy_scene() {
+  wp::Scene s = busy_scene();
+  s.materials[0].specular = 0.5f;
+  s.materials[0].ior = 1.0f;
+  const float roughness[] = {0.0316f, 0.0317f, 0.6f};
+  for (int i = 0; i < 3; ++i) {
+    wp::Material m;
+    m.base_color = glm::vec4(0.3f + 0.2f * static_cast<float>(i), 0.6f, 0.4f, 1.0f);
+    m.metallic = i == 2 ? 0.0f : 0.8f;
+    m.roughness = roughness[i];
+    m.ior = i == 2 ? 3.0f : 1.5f;
+    s.materials.push_back(m);
+    wp::test::add_sphere(s, {-1.2f + 0.7f * static_cast<float>(i), 0.3f, 1.0f}, 0.3f, 12, 24,
+                         static_cast<std::uint32_t>(s.materials.size() - 1));
+  }
+  wp::test::finish_bounds(s);
+  return s;
+}
+
+// The glossy busy scene textured (WP_FEATURE_TEXTURES, ray cones, normal maps, alpha: each hit is
+// shade_hit's lane by lane, the light and BSDF samples in the lanes): a random 4 x 4 texture as
+// the floor's base colour, the glossy sphere's metallic-roughness and normal map, and the lamp's
+// emission (so that NEE toward a textured emitter is the one-path code's), and the lamp quad cut
+// out where alpha < 0.5 (MASK). Every vertex takes its x-z position as uv.
+wp::Scene textured_busy_scene() {
+  wp::Scene s = glossy_busy_scene();
+  std::vector<std::uint8_t> rgba(4 * 4 * 4);
+  std::uint32_t state = 12345u;
+  for (std::uint8_t& c : rgba)
+    c = static_cast<std::uint8_t>((state = state * 1664525u + 1013904223u) >> 24);
+  const auto add_texture = [&](bool srgb) {
+    wp::Image img;
+    img.width = img.height = 4;
+    img.rgba = rgba;
+    s.images.push_back(img);
+    wp::TextureRef t;
+    t.image = static_cast<int>(s.images.size() - 1);
+    t.srgb = srgb;
+    s.textures.push_back(t);
+    return static_cast<int>(s.textures.size() - 1);
+  };
+  s.materials[0].base_color_texture = add_texture(true);
+  s.materials[1].metallic_roughness_texture = add_texture(false);
+  s.materials[1].normal_texture = add_texture(false);
+  s.materials[3].emissive_texture = add_texture(true);
+  s.materials[3].alpha_mode = wp::AlphaMode::kMask;
+  s.materials[3].base_color_texture = add_texture(true);
+  s.uv0.resize(s.positions.size());
+  for (std::size_t k = 0; k < s.positions.size(); ++k)
+    s.uv0[k] = {s.positions[k].x, s.positions[k].z};
+  wp::test::finish_bounds(s);
+  return s;
+}
+
+// In a scene of Lambertian or plain glTF surfaces (WP_BSDF_PLAIN: bsdf/glossy.def in lanes, delta
+// lobes lane by lane), textured or not, the fused kernel shades eight paths per work-item on PoCL's
+// CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path kernel's bit
+// for bit, with every kind of light sample (the lamp's triangles and the constant background in
+// SIMD lanes, the point light by the single-path function), each sampler and strategy, and several
+// waves of different sizes (which paths share a packet changes nothing). The default suite takes
+// the textured scene under Sobol' and MIS, and the Lambertian one in the cases below;
+// ...Exhaustive (slow) the untextured glossy scene (whose surfaces the lanes resolve) and each
+// sampler and strategy.
 TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
-  wp::Scene s = lambert_busy_scene();
   using wp::Sampler, wp::Strategy;
-  expect_packets_match_single_paths(*runtime_, s, {{Sampler::kSobol, Strategy::kMis, 1000}});
+  expect_packets_match_single_paths(*runtime_, textured_busy_scene(),
+                                    {{Sampler::kSobol, Strategy::kMis, 1000}});
+  wp::Scene s = lambert_busy_scene();
   // Rows not a multiple of eight pixels, so that camera-ray packets span two rows (start_paths8
   // counts pixels on from the first one's), and waves of two samples of the image (a packet across
   // the samples' boundary), of 1000 and of 8 paths: 61 x 37, with a wall behind everything, a
@@ -804,6 +868,14 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
 
 TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilmExhaustive) {
   using wp::Sampler, wp::Strategy;
+  expect_packets_match_single_paths(*runtime_, textured_busy_scene(),
+                                    {{Sampler::kIndependent, Strategy::kMis, 0}});
+  expect_packets_match_single_paths(*runtime_, glossy_busy_scene(),
+                                    {{Sampler::kSobol, Strategy::kMis, 1000},
+                                     {Sampler::kSobol, Strategy::kNee, 0},
+                                     {Sampler::kSobol, Strategy::kBsdf, 1000},
+                                     {Sampler::kSobolPadded, Strategy::kMis, 1000},
+                                     {Sampler::kIndependent, Strategy::kMis, 0}});
   expect_packets_match_single_paths(*runtime_, lambert_busy_scene(),
                                     {{Sampler::kSobol, Strategy::kMis, 1000},
                                      {Sampler::kSobol, Strategy::kNee, 0},

@@ -495,12 +495,14 @@ Config with_samples(Config c, std::uint32_t samples) {
 
 const float4 kWhite = {1, 1, 1, 0}, kSaturated = {0.9f, 0.1f, 0.02f, 0};
 
-// The eight-lane twins of common.h, elementary.h and sampling/warps.h
-// (tests/kernels/lanes_kernels.cl) against their scalar originals on the same inputs, bit for bit,
+// The eight-lane forms of common.h's helpers and of the lane code of elementary.h and
+// sampling/warps.h (tests/kernels/lanes_kernels.cl) against their one-path forms on the same
+// inputs, bit for bit,
 // as the packet kernels need (integrator/shade_packet.h: the same images with and without packets):
 // vectors whose squared length is zero, subnormal, just inside and outside (1e-30, 1e30) (where
 // length3x8 and normalize3x8 hand the lane to the builtin) or huge, mixed in one packet with
-// ordinary ones, and signed zeros; fractions of a turn and unit-square points at their boundaries.
+// ordinary ones, and signed zeros; fractions of a turn and unit-square points at their boundaries
+// (which also make the GGX functions' views, alphas and numbers).
 // NaN results (the zero vector's normal) must be NaN on both sides. Built with and without
 // WP_PREFETCH (lane_bits8's x86 builtin or its generic form).
 TEST(LaneTwins, MatchTheirScalarFunctions) {
@@ -554,11 +556,12 @@ TEST(LaneTwins, MatchTheirScalarFunctions) {
   };
   const char* names[] = {"length",       "normalize",         "dot",
                          "cross",        "make_basis t",      "make_basis b",
-                         "cos_sin_turn", "cosine hemisphere", "offset_origin"};
+                         "cos_sin_turn", "cosine hemisphere", "offset_origin",
+                         "GGX visible normal", "GGX D, V, pdf"};
   for (const char* options : {"-D WP_SHADE_PACKET=1", "-D WP_SHADE_PACKET=1 -D WP_PREFETCH=1"}) {
     wp::test::KernelHarness h({"lanes_kernels.cl"}, options);
-    for (cl_uint fn = 0; fn < 9; ++fn) {
-      const std::vector<cl_float4>& in = fn == 6 || fn == 7 ? fractions : vectors;
+    for (cl_uint fn = 0; fn < 11; ++fn) {
+      const std::vector<cl_float4>& in = fn == 6 || fn == 7 || fn >= 9 ? fractions : vectors;
       const auto groups = static_cast<cl_uint>(in.size() / 8);
       cl::Buffer b_in = h.buffer(in), lanes = h.buffer<cl_float4>(in.size()),
                  scalar = h.buffer<cl_float4>(in.size());

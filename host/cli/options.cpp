@@ -332,7 +332,8 @@ void add_engine_options(CLI::App* app, CliOptions& cli, wp::RenderSettings& sett
   app->add_flag("--no-shade-packets", cli.no_shade_packets,
                 "Shade each path, and start its camera ray, on its own (by default PoCL's CPU "
                 "devices take eight paths to a work-item in SIMD lanes where every surface is "
-                "untextured Lambertian, without instances or AOVs; the same image either way)");
+                "untextured, Lambertian or metallic-roughness without extensions or transmission, "
+                "without instances or AOVs; the same image either way)");
   app->add_flag("--force-packets", cli.force_packets,
                 "Use the eight-lane packet kernels (rays, shading and camera rays in SIMD lanes) "
                 "on any device, for testing them elsewhere, e.g. under Oclgrind "

@@ -155,14 +155,12 @@ void plan_program(RenderPlan& plan, const RenderSettings& settings, const bvh::B
   if (plan.closest_packet > 1 && bvh.blocks.size() <= kMaskedClosestBlocks)
     options += " -D WP_PACKET_MASKED_CLOSEST=1";
   // Shading eight paths per work-item, float8 lanes being paths, where every scattering surface
-  // is Lambertian and untextured (kernels/integrator/shade_packet.h says what it needs).
-  const bool lambertian = !f.glossy && !f.textures && !f.texture_lod && !f.normal_maps &&
-                          !f.vertex_colors && !f.alpha && !f.unlit && !f.transmission &&
-                          !f.volume && !f.specular && !f.clearcoat && !f.sheen && !f.anisotropy &&
-                          !f.iridescence && !f.diffuse_transmission && !f.dispersion &&
-                          !f.instances;
-  plan.shade_packet =
-      settings.shade_packets && packets_here && lambertian && !settings.aov ? 8u : 1u;
+  // is Lambertian or glTF's metallic-roughness without extensions or transmission, textured or
+  // not (kernels/integrator/shade_packet.h says what it needs).
+  const bool plain = !f.transmission && !f.volume && !f.specular && !f.clearcoat && !f.sheen &&
+                     !f.anisotropy && !f.iridescence && !f.diffuse_transmission && !f.dispersion &&
+                     !f.instances;
+  plan.shade_packet = settings.shade_packets && packets_here && plain && !settings.aov ? 8u : 1u;
   if (plan.shade_packet > 1) options += " -D WP_SHADE_PACKET=1";
   const bool forced = !plan.pocl_cpu &&
                       (plan.shade_packet > 1 || plan.shadow_packet > 1 || plan.closest_packet > 1);

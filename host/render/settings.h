@@ -87,8 +87,8 @@ struct RenderSettings {
   // image; tests set it below 1 so that the rest is launched.
   float shadow_ahead = 1.03f;
   // The fused shade kernel eight paths per work-item (kernels/integrator/shade_packet.h) on
-  // PoCL's CPU devices, in scenes of untextured Lambertian surfaces without instances or AOVs.
-  // The same image.
+  // PoCL's CPU devices, in scenes of untextured surfaces, Lambertian or metallic-roughness
+  // without extensions or transmission, without instances or AOVs. The same image.
   bool shade_packets = true;
   // The packet kernels above on any device, not only on PoCL's CPU devices (tests run them under
   // Oclgrind with it). The same image.

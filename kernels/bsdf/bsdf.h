@@ -84,6 +84,16 @@
 #include "bsdf/diffuse_transmission.h"
 #include "bsdf/lambert.h"
 
+/* The BSDF of WP_BSDF_PLAIN programs (lane code: util/lanes_begin.def). */
+#if WP_BSDF_PLAIN
+#define WP_LW 1
+#include "bsdf/glossy.def"
+#if WP_SHADE_PACKET
+#define WP_LW 8
+#include "bsdf/glossy.def"
+#endif
+#endif
+
 /* Nothing but delta lobes: light sampling cannot contribute (bsdf_eval is 0 everywhere). Also
  * where a dispersive refraction has still to choose the path's channel: the sampled direction
  * then counts with MIS weight 1, as a delta lobe's. */
@@ -183,9 +193,15 @@ static inline BsdfView bsdf_view(const Surface* s, float3 wo) {
   v.cos_o = dot(s->ns, wo);
 #if WP_FEATURE_GLOSSY
   v.eta = relative_ior(s);
-  const Lobes none = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  Lobes none = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+#if WP_BSDF_PLAIN
+  (void)wo;
+  if (v.cos_o > 0.0f) none.diff = glossy_lobes(s, v.cos_o, v.eta, &none.spec);
+  v.lobes = none;
+#else
   /* Only above the surface: the sheen table is looked up at cos_o. */
   v.lobes = v.cos_o > 0.0f ? bsdf_lobes(s, wo, v.cos_o, v.eta) : none;
+#endif
 #endif
   return v;
 }
@@ -197,6 +213,10 @@ WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval_view(const Surface* s, const BsdfView* v,
 #if !WP_FEATURE_GLOSSY
   (void)wo;
   return lambert_eval(s, v->cos_o, wi);
+#elif WP_BSDF_PLAIN
+  BsdfEval e;
+  e.f = glossy_f(s, wo, wi, v->cos_o, v->eta, v->lobes.spec, v->lobes.diff, &e.pdf);
+  return e;
 #else
   BsdfEval e = {(float3)(0.0f), 0.0f};
   const float cos_i = dot(s->ns, wi), cos_o = v->cos_o;
@@ -251,7 +271,7 @@ static inline int sample_extra_lobe(const Surface* s, float3 wo, float3 t, float
 #endif
 #if WP_FEATURE_SHEEN
   if (v < l.sheen) {
-    *wi_l = sample_cosine_hemisphere(u);
+    *wi_l = sample_cosine_hemisphere(u.x, u.y);
     return 0;
   }
   v -= l.sheen;
@@ -268,6 +288,20 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, const BsdfView* v, 
   BsdfSample r;
   r.valid = false, r.delta = false, r.pdf = 0.0f, r.eta_scale = 1.0f;
   r.weight = (float3)(0.0f), r.wi = (float3)(0.0f);
+#if WP_BSDF_PLAIN
+  if (!(v->cos_o > 0.0f)) return r;
+  if (u_lobe < v->lobes.spec && bsdf_has_delta(s))
+    return sample_delta(s, wo, v->cos_o, v->eta, v->lobes, false);
+  int valid;
+  const float3 wi = glossy_sample(s, wo, v->cos_o, v->eta, v->lobes.spec, v->lobes.diff, u_lobe,
+                                  u.x, u.y, &r.weight, &r.pdf, &valid);
+  if (!valid) {
+    r.weight = (float3)(0.0f), r.pdf = 0.0f;
+    return r;
+  }
+  r.wi = wi, r.valid = true;
+  return r;
+#else
   float3 t, b;
 #if WP_FEATURE_ANISOTROPY
   if (bsdf_anisotropic(s)) {
@@ -292,7 +326,7 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, const BsdfView* v, 
       h = sample_ggx_aniso_visible_normal(wo_l, a.x, a.y, u);
     } else
 #endif
-      h = sample_ggx_visible_normal(wo_l, sqr(s->roughness), u);
+      h = sample_ggx_visible_normal(wo_l, sqr(s->roughness), u.x, u.y);
     const float o_h = dot(wo_l, h);
     const float p_reflect = reflect_prob(microfacet_weights(s, o_h, eta));
     trans = u_lobe >= g * p_reflect; /* u_lobe / g is uniform in [0, 1) here */
@@ -314,7 +348,7 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, const BsdfView* v, 
     if (extra == 1) return r;
     if (extra == 2)
 #endif
-      wi_l = sample_cosine_hemisphere(u);
+      wi_l = sample_cosine_hemisphere(u.x, u.y);
   }
   /* A lobe's direction on the other side than the lobe covers (a reflection below the surface,
    * a transmission above it) has no density in that lobe: evaluating it there would mix in the
@@ -327,6 +361,7 @@ static inline BsdfSample bsdf_sample_lobes(const Surface* s, const BsdfView* v, 
   r.weight = e.f * fabs(dot(s->ns, r.wi)) / e.pdf;
   r.valid = true;
   return r;
+#endif /* WP_BSDF_PLAIN */
 }
 #endif /* WP_FEATURE_GLOSSY */
 
@@ -367,6 +402,48 @@ static inline BsdfSample bsdf_sample_view(const Surface* s, const BsdfView* v, f
   return bsdf_sample_lobes(s, v, wo, u_lobe, u);
 #endif
 }
+
+#if WP_SHADE_PACKET
+/* bsdf_view, bsdf_eval_view and bsdf_sample_view of eight lanes (closure.h, Surface8), for the
+ * shade packets' programs: Lambert's lobe, or WP_BSDF_PLAIN's BSDF at surfaces without a delta
+ * lobe (those paths are shaded one at a time). The sample's weight in *weight, its density in
+ * *pdf and whether there is one in *valid. */
+WP_LANES_FN BsdfView8 bsdf_view8(const Surface8* s, Float3x8 wo) {
+  BsdfView8 v;
+  v.cos_o = dot3x8(s->ns, wo);
+#if WP_FEATURE_GLOSSY
+  v.eta = s->ior; /* relative_ior without volumes */
+  float8 spec;
+  const float8 diff = glossy_lobes8(s, v.cos_o, v.eta, &spec);
+  const int8 above = v.cos_o > 0.0f;
+  v.spec = select((float8)(0.0f), spec, above), v.diff = select((float8)(0.0f), diff, above);
+#endif
+  return v;
+}
+
+WP_LANES_FN Float3x8 bsdf_eval8(const Surface8* s, const BsdfView8* v, Float3x8 wo, Float3x8 wi,
+                                float8* pdf) {
+#if WP_FEATURE_GLOSSY
+  return glossy_f8(s, wo, wi, v->cos_o, v->eta, v->spec, v->diff, pdf);
+#else
+  (void)wo;
+  return lambert_f8(s, v->cos_o, wi, pdf);
+#endif
+}
+
+WP_LANES_FN Float3x8 bsdf_sample8(const Surface8* s, const BsdfView8* v, Float3x8 wo, float8 u_lobe,
+                                  float8 ux, float8 uy, Float3x8* weight, float8* pdf,
+                                  int8* valid) {
+#if WP_FEATURE_GLOSSY
+  return glossy_sample8(s, wo, v->cos_o, v->eta, v->spec, v->diff, u_lobe, ux, uy, weight, pdf,
+                        valid);
+#else
+  (void)wo, (void)u_lobe;
+  *weight = s->color;
+  return lambert_direction8(s, v->cos_o, ux, uy, pdf, valid);
+#endif
+}
+#endif
 
 /* f and pdf for the pair (wo, wi); bsdf_eval_view with a view made for it. */
 WP_BSDF_EVAL_INLINE BsdfEval bsdf_eval(const Surface* s, float3 wo, float3 wi) {

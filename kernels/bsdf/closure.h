@@ -59,6 +59,37 @@ typedef struct Surface {
 #endif
 } Surface;
 
+/* glTF's metallic-roughness BSDF alone: a glossy program without transmission, volume, dispersion
+ * or a layered extension. Its BSDF is bsdf/glossy.def's, one source for one path and for the
+ * shade packets' eight lanes. */
+#define WP_BSDF_PLAIN                                                                              \
+  (WP_FEATURE_GLOSSY && !WP_FEATURE_TRANSMISSION && !WP_FEATURE_VOLUME &&                          \
+   !WP_FEATURE_DISPERSION && !WP_FEATURE_SPECULAR && !WP_FEATURE_CLEARCOAT && !WP_FEATURE_SHEEN && \
+   !WP_FEATURE_ANISOTROPY && !WP_FEATURE_IRIDESCENCE && !WP_FEATURE_DIFFUSE_TRANSMISSION)
+
+#if WP_SHADE_PACKET
+/* Eight Surfaces in SIMD lanes (common.h, Float3x8) for the shade packets (integrator/
+ * shade_packet.h): the fields of the materials those programs have, under the same names, so that
+ * lane code (util/lanes_begin.def) reads either; front is WP_SURF_FRONT of flags. */
+typedef struct Surface8 {
+  Float3x8 p, ng, ns, color;
+  float8 p_scale;
+#if WP_FEATURE_GLOSSY
+  float8 metallic, roughness, ior, specular;
+#endif
+  int8 front;
+} Surface8;
+
+/* bsdf_view of eight lanes (bsdf.h): ns . wo, and with WP_FEATURE_GLOSSY the relative index and
+ * the specular and diffuse lobes' probabilities. */
+typedef struct BsdfView8 {
+  float8 cos_o;
+#if WP_FEATURE_GLOSSY
+  float8 eta, spec, diff;
+#endif
+} BsdfView8;
+#endif
+
 typedef struct BsdfEval {
   float3 f;  /* BSDF value (no cosine), delta lobes excluded */
   float pdf; /* solid-angle density with which bsdf_sample would produce wi */
@@ -76,7 +107,6 @@ typedef struct BsdfSample {
   uint channel; /* the path's channel after this sample (Surface.channel) */
 #endif
 } BsdfSample;
-
 
 /* Lobe selection probabilities; they sum to 1. spec + trans is the probability of the
  * microfacet lobes together (reflection and transmission share one sampled microfacet normal and

@@ -32,7 +32,7 @@ static inline void eval_diffuse_transmission(const Surface* s, float3 wo, float3
  * first): *wi_l in the sampling frame of ns, *trans set. */
 static inline void diffuse_transmission_sample(const Surface* s, float2 u, float3* wi_l,
                                                bool* trans, BsdfSample* r) {
-  *wi_l = sample_cosine_hemisphere(u);
+  *wi_l = sample_cosine_hemisphere(u.x, u.y);
   wi_l->z = -wi_l->z;
   *trans = true;
   if (bsdf_volume(s)) r->eta_scale = sqr(relative_ior(s));

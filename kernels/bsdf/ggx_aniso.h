@@ -111,10 +111,11 @@ static inline float3 sample_ggx_aniso_visible_normal(float3 wo, float ax, float 
       len2 > 0.0f ? (float3)(-vh.y, vh.x, 0.0f) * rsqrt(len2) : (float3)(1.0f, 0.0f, 0.0f);
   const float3 t2 = cross(vh, t1);
   const float r = sqrt(u.x);
-  const float2 cs = cos_sin_turn(u.y);
-  const float p1 = r * cs.x;
+  float c, s_turn;
+  cos_sin_turn(u.y, &c, &s_turn);
+  const float p1 = r * c;
   const float s = 0.5f * (1.0f + vh.z);
-  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * cs.y;
+  const float p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * r * s_turn;
   const float3 nh = p1 * t1 + p2 * t2 + sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
   return normalize((float3)(ax * nh.x, ay * nh.y, fmax(1e-7f, nh.z)));
 }

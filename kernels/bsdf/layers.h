@@ -129,7 +129,7 @@ static inline int coat_sample(const Surface* s, float3 wo, float3 t, float3 b, L
   make_basis(nc, &tc, &bc);
   const float3 oc = (float3)(dot(wo, tc), dot(wo, bc), dot(wo, nc));
   if (!(oc.z > 0.0f)) return 1; /* r stays invalid */
-  const float3 h = sample_ggx_visible_normal(oc, sqr(s->clearcoat_roughness), u);
+  const float3 h = sample_ggx_visible_normal(oc, sqr(s->clearcoat_roughness), u.x, u.y);
   const float3 ic = 2.0f * dot(oc, h) * h - oc;
   if (!(ic.z > 0.0f)) return 1; /* below the coat: no density in the coat's lobe, lost */
   const float3 w = ic.x * tc + ic.y * bc + ic.z * nc; /* to the sampling frame of ns */

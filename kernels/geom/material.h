@@ -308,18 +308,26 @@ WP_LANES_FN Float3x8 interpolate3x8(Float3x8 a0, Float3x8 a1, Float3x8 a2, float
   return r;
 }
 
-/* resolve_surface of eight lanes for a program of untextured Lambertian materials without
- * instances (shade_packet.h): triangle tri[i] hit at (u, v) by a ray along ray_d, lane by lane;
- * its vertices and material in tv[i]. */
+/* resolve_surface of eight lanes for a program of untextured materials without instances whose
+ * BSDF is Lambert's or WP_BSDF_PLAIN's (shade_packet.h): triangle tri[i] hit at (u, v) by a ray
+ * along ray_d, lane by lane; its vertices and material in tv[i]. */
 WP_LANES_FN Surface8 resolve_surface8(const SceneView* scene, const uint* tri, float8 u, float8 v,
                                       Float3x8 ray_d, uint4* tv) {
   uint i0[8], i1[8], i2[8];
   float4 c[8];
+#if WP_FEATURE_GLOSSY
+  float4 q[8];
+  float specular[8];
+#endif
 #pragma unroll
   for (int i = 0; i < 8; ++i) {
     tv[i] = scene->tri_vertices[tri[i]];
     i0[i] = tv[i].x, i1[i] = tv[i].y, i2[i] = tv[i].z;
     c[i] = scene->materials[tv[i].w].base_color;
+#if WP_FEATURE_GLOSSY
+    q[i] = scene->materials[tv[i].w].params;
+    specular[i] = scene->materials[tv[i].w].specular.w;
+#endif
   }
   const Float3x8 p0 = gather3x8(scene->positions, i0), p1 = gather3x8(scene->positions, i1),
                  p2 = gather3x8(scene->positions, i2);
@@ -340,6 +348,10 @@ WP_LANES_FN Surface8 resolve_surface8(const SceneView* scene, const uint* tri, f
   s.ns = select3x8(s.ng, s.ns, dot3x8(s.ns, neg3x8(ray_d)) > 1e-4f);
   float8 unused;
   transpose4x8(c, &s.color.x, &s.color.y, &s.color.z, &unused);
+#if WP_FEATURE_GLOSSY /* resolve_material's (no transmission: WP_BSDF_PLAIN) */
+  transpose4x8(q, &s.metallic, &s.roughness, &s.ior, &unused);
+  s.specular = vload8(0, specular);
+#endif
   return s;
 }
 

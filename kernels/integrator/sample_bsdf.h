@@ -59,17 +59,18 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
 
 #if WP_SHADE_PACKET
 /* sample_next_ray and then roulette of eight lanes (common.h, shade_packet.h) for the paths in
- * slots[i] whose bit is set in `lanes`: surface s seen at cosine cos_o, hit at distance t along
- * ray_d, throughput beta, at `bounce`, (ux, uy) the direction's numbers and u_rr roulette's.
- * Returns the lanes that survive roulette. */
+ * slots[i] whose bit is set in `lanes`, at surfaces without a delta lobe: surface s seen as v,
+ * hit at distance t along ray_d, throughput beta, at `bounce`, u_lobe the lobe's number, (ux, uy)
+ * the direction's and u_rr roulette's. Returns the lanes that survive roulette. */
 WP_LANES_FN uint sample_next_ray8(Paths paths, Queues queues, Launch launch, const uint* slots,
-                                  uint lanes, const Surface8* s, float8 cos_o, Float3x8 ray_d,
-                                  float8 t, Float3x8 beta, uint8 bounce, float8 ux, float8 uy,
-                                  float8 u_rr) {
+                                  uint lanes, const Surface8* s, const BsdfView8* v, Float3x8 ray_d,
+                                  float8 t, Float3x8 beta, uint8 bounce, float8 u_lobe, float8 ux,
+                                  float8 uy, float8 u_rr) {
   float8 pdf;
   int8 valid;
-  const Float3x8 wi = lambert_sample8(s, cos_o, ux, uy, &pdf, &valid);
-  const Float3x8 next = {beta.x * s->color.x, beta.y * s->color.y, beta.z * s->color.z};
+  Float3x8 weight;
+  const Float3x8 wi = bsdf_sample8(s, v, neg3x8(ray_d), u_lobe, ux, uy, &weight, &pdf, &valid);
+  const Float3x8 next = mul3x8(beta, weight);
   const int8 finite = finite3x8(next) && isfinite(pdf);
   const Float3x8 o = surface_spawn8(s, ray_d, t, wi);
   float eta[8];
@@ -98,8 +99,13 @@ WP_LANES_FN uint sample_next_ray8(Paths paths, Queues queues, Launch launch, con
       path_store_throughput(paths, slot, (float3)(0.0f), 0.0f);
       continue;
     }
-    /* a Lambertian sample: the eta scale as it was, no flags (no delta lobe) */
+    /* no delta lobe, no refraction: no flags, the eta scale as it was */
+#if WP_FEATURE_TEXTURE_LOD /* and the ray cone widened by the lobe (ray_cone.h) */
+    path_set_flags_word(
+        paths, slot, with_high_bf16(0u, path_cone(paths, slot).y + lobe_spread(lane_of(pdf, i))));
+#else
     path_set_flags(paths, slot, 0u);
+#endif
     path_store_throughput(paths, slot, lane3(kept, i), lane_of(pdf, i));
     path_store_ray_o(paths, slot, lane3(o, i), 0.0f);
     path_store_ray_d(paths, slot, lane3(wi, i), 0.0f);

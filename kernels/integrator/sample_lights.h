@@ -51,12 +51,12 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
 #if WP_SHADE_PACKET
 /* sample_light_ray of eight lanes (common.h, shade_packet.h) for the paths in slots[i] whose bit
  * is set in `lanes`: their light is emissive triangle tri[i], or the constant background where
- * bit i of `env` is set, picked with probability pmf, the point at (ux, uy); surface s seen at
- * cosine cos_o, hit at distance t along ray_d, throughput beta; weighed for `strategy`. Returns
- * the lanes with a shadow ray. */
+ * bit i of `env` is set, picked with probability pmf, the point at (ux, uy); surface s (without a
+ * delta lobe) seen as v, hit at distance t along ray_d, throughput beta; weighed for `strategy`.
+ * Returns the lanes with a shadow ray. */
 WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues queues,
                                    const uint* slots, uint lanes, uint env, const Surface8* s,
-                                   float8 cos_o, Float3x8 ray_d, float8 t, Float3x8 beta,
+                                   const BsdfView8* v, Float3x8 ray_d, float8 t, Float3x8 beta,
                                    const uint* tri, float8 pmf, float8 ux, float8 uy,
                                    uint strategy) {
   LightSample8 ls = sample_triangle8(scene, tri, s->p, ux, uy);
@@ -70,7 +70,7 @@ WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues q
   }
   ls.pdf *= pmf;
   float8 e_pdf;
-  const Float3x8 f = lambert_eval8(s, cos_o, ls.wi, &e_pdf);
+  const Float3x8 f = bsdf_eval8(s, v, neg3x8(ray_d), ls.wi, &e_pdf);
   const float8 w = mis_weight_light8(ls.pdf, e_pdf, strategy);
   const float8 k = fabs(dot3x8(s->ns, ls.wi)) * w / ls.pdf;
   const Float3x8 c = {beta.x * f.x * ls.li.x * k, beta.y * f.y * ls.li.y * k,

@@ -1,10 +1,13 @@
 /* The fused shading stage for eight paths per work-item, float8 lanes being paths, in programs
- * whose every scattering surface is untextured and Lambertian (WP_SHADE_PACKET: the host's choice
- * on PoCL's CPU devices, which run a kernel's work-items one after another, so SIMD across paths
- * has to be written out). Each path gets exactly what shade.cl's single-path body gives it: a
- * miss, emission, a light other than a triangle and roulette go through the same functions lane
- * by lane; the surface, a triangle light's sample and the next ray through their twins of eight
- * lanes, each beside its original (common.h says why) and computing the same expressions. */
+ * whose every scattering surface is untextured, with Lambert's BSDF or glTF's metallic-roughness
+ * one without extensions (WP_BSDF_PLAIN) (WP_SHADE_PACKET: the host's choice on PoCL's CPU
+ * devices, which run a kernel's work-items one after another, so SIMD across paths has to be
+ * written out). Each path gets exactly what shade.cl's single-path body gives it: a miss,
+ * emission, a light other than a triangle or the constant background, and a surface with a delta
+ * lobe go through the same functions lane by lane; the BSDF through its lane code
+ * (util/lanes_begin.def: one source for one path and eight); the surface, a triangle light's
+ * sample and the next ray through their twins of eight lanes, each beside its original (common.h
+ * says why) and computing the same expressions. */
 #ifndef WP_INTEGRATOR_SHADE_PACKET_H
 #define WP_INTEGRATOR_SHADE_PACKET_H
 
@@ -14,12 +17,18 @@
 #include "integrator/shade_surface.h"
 
 #if WP_SHADE_PACKET
-#if WP_FEATURE_GLOSSY || WP_FEATURE_TEXTURES || WP_FEATURE_TEXTURE_LOD ||                          \
-    WP_FEATURE_NORMAL_MAPS || WP_FEATURE_VERTEX_COLORS || WP_FEATURE_ALPHA || WP_FEATURE_UNLIT ||  \
-    WP_FEATURE_TRANSMISSION || WP_FEATURE_VOLUME || WP_BSDF_EXTENSIONS || WP_FEATURE_DISPERSION || \
-    WP_BVH_INSTANCES || WP_AOV
-#error "WP_SHADE_PACKET: programs of untextured Lambertian surfaces without instances or AOVs"
+#if (WP_FEATURE_GLOSSY && !WP_BSDF_PLAIN) || WP_FEATURE_TRANSMISSION || WP_FEATURE_VOLUME || \
+    WP_BSDF_EXTENSIONS || WP_FEATURE_DISPERSION || WP_BVH_INSTANCES || WP_AOV
+#error "WP_SHADE_PACKET: programs of Lambert's or WP_BSDF_PLAIN's BSDF without instances or AOVs"
 #endif
+
+/* Programs whose surfaces the lanes cannot resolve (textures, ray cones, normal maps, vertex
+ * colours, unlit materials; alpha, whose emission reads textures): there each hit is shade_hit's,
+ * lane by lane, emission and all, and the surfaces it gives are put in lanes (surface8_of) for
+ * the light sample and the BSDF's. Elsewhere resolve_surface8 does it in the lanes. */
+#define WP_SHADE_HITS_BY_LANE                                                 \
+  (WP_FEATURE_TEXTURES || WP_FEATURE_TEXTURE_LOD || WP_FEATURE_NORMAL_MAPS || \
+   WP_FEATURE_VERTEX_COLORS || WP_FEATURE_ALPHA || WP_FEATURE_UNLIT)
 
 #define WP_SHADE_LANES 8
 
@@ -31,6 +40,51 @@ static inline bool background_dark(const SceneView* scene) {
 #endif
   return !(max3(scene->desc->background.xyz) > 0.0f);
 }
+
+#if WP_FEATURE_GLOSSY
+/* What shade.cl's body does after shade_hit for the path in `slot`, lane i of the packet (surface
+ * one, hit at distance t along ray_d, the bounce's numbers u), by the one-path functions: bits i
+ * of *shadow and *survives set where it has a shadow ray and a next ray. */
+WP_LANES_FN void shade_lane(const SceneView* scene, Paths paths, Queues queues, Launch launch,
+                            uint slot, const Surface* one, int i, float3 ray_d, float t,
+                            const BounceRandom* u, uint* shadow, uint* survives) {
+  const BsdfView v = bsdf_view(one, -ray_d);
+  if (launch.strategy != WP_STRATEGY_BSDF &&
+      sample_light_ray(scene, paths, queues, slot, one, &v, t, u, launch.strategy))
+    *shadow |= 1u << i;
+  sample_next_ray(paths, queues, slot, one, &v, t, u);
+  if (roulette(paths, queues, launch, slot, u->roulette)) *survives |= 1u << i;
+}
+#endif
+
+#if WP_SHADE_HITS_BY_LANE
+/* Eight surfaces in lanes (closure.h, Surface8). */
+WP_LANES_FN Surface8 surface8_of(const Surface* one) {
+  Surface8 s;
+  float4 v[8];
+  float8 w, unused;
+  for (int i = 0; i < 8; ++i) v[i] = (float4)(one[i].p, one[i].p_scale);
+  transpose4x8(v, &s.p.x, &s.p.y, &s.p.z, &s.p_scale);
+  for (int i = 0; i < 8; ++i)
+    v[i] = (float4)(one[i].ng, (one[i].flags & WP_SURF_FRONT) ? 1.0f : 0.0f);
+  transpose4x8(v, &s.ng.x, &s.ng.y, &s.ng.z, &w);
+  s.front = w != 0.0f;
+#if WP_FEATURE_GLOSSY
+  for (int i = 0; i < 8; ++i) v[i] = (float4)(one[i].ns, one[i].metallic);
+  transpose4x8(v, &s.ns.x, &s.ns.y, &s.ns.z, &s.metallic);
+  for (int i = 0; i < 8; ++i) v[i] = (float4)(one[i].color, one[i].roughness);
+  transpose4x8(v, &s.color.x, &s.color.y, &s.color.z, &s.roughness);
+  for (int i = 0; i < 8; ++i) v[i] = (float4)(one[i].ior, one[i].specular, 0.0f, 0.0f);
+  transpose4x8(v, &s.ior, &s.specular, &unused, &w);
+#else
+  for (int i = 0; i < 8; ++i) v[i] = (float4)(one[i].ns, 0.0f);
+  transpose4x8(v, &s.ns.x, &s.ns.y, &s.ns.z, &unused);
+  for (int i = 0; i < 8; ++i) v[i] = (float4)(one[i].color, 0.0f);
+  transpose4x8(v, &s.color.x, &s.color.y, &s.color.z, &unused);
+#endif
+  return s;
+}
+#endif
 
 /* The shading of the paths in entries [first, first + WP_SHADE_LANES) of launch.queue_in, as
  * shade.cl's body shades each: their slots, and in bit i of *shadow and *survives whether path i
@@ -73,7 +127,7 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
   transpose4x8(b, &beta.x, &beta.y, &beta.z, &bsdf_pdf);
   /* The bounce's numbers (bounce_random), by their use: light pick, light point, direction,
    * roulette. */
-  float8 u[6];
+  float8 u[7];
   uint bo[WP_SHADE_LANES];
   for (int i = 0; i < WP_SHADE_LANES; ++i) bo[i] = path_bounce(paths, sl[i]);
   const uint8 bounce = vload8(0, bo);
@@ -86,7 +140,7 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
     /* The light pick's own number only past WP_LIGHT_PICK_REUSE_MAX lights (sample_light),
      * roulette's only at its depth (roulette). */
     rng_bounce_lanes(r, u, scene->desc->light_count > WP_LIGHT_PICK_REUSE_MAX,
-                     any8(bounce + 1u >= (uint8)(launch.rr_depth)));
+                     any8(bounce + 1u >= (uint8)(launch.rr_depth)), WP_FEATURE_GLOSSY);
   }
 #else
   {
@@ -96,15 +150,28 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
       const float8 v = rng_bounce(path_rng(paths, sl[i], launch));
       lo[i] = v.lo, hi[i] = v.hi;
     }
-    float8 lobe, unused;
-    transpose4x8(lo, &u[0], &u[1], &lobe, &u[3]);
+    float8 unused;
+    transpose4x8(lo, &u[0], &u[1], &u[6], &u[3]);
     transpose4x8(hi, &u[5], &u[2], &u[4], &unused);
   }
 #endif
   const float8 light_pick = u[0], light_u = u[1], light_v = u[2], bsdf_u = u[3], bsdf_v = u[4],
-               roulette_u = u[5];
+               roulette_u = u[5], lobe_u = u[6];
   uint tri[WP_SHADE_LANES];
   vstore8(as_uint8(tri_bits), 0, tri);
+#if WP_SHADE_HITS_BY_LANE
+  /* Each hit by shade_hit, emission and all; the paths that scatter, whose surfaces go to the
+   * lanes (the others' lanes take the first one's). */
+  (void)hu, (void)hv;
+  Surface one[WP_SHADE_LANES];
+  uint go = 0u;
+  for (int i = 0; i < n; ++i)
+    if (((hits >> i) & 1u) && shade_hit(scene, paths, launch, slots[i], &one[i])) go |= 1u << i;
+  if (go == 0u) return;
+  for (int i = 0; i < WP_SHADE_LANES; ++i)
+    if (!((go >> i) & 1u)) one[i] = one[lowest_bit((int)go)];
+  const Surface8 s = surface8_of(one);
+#else
   uint4 tv[WP_SHADE_LANES];
   const Surface8 s = resolve_surface8(scene, tri, hu, hv, ray_d, tv);
 #if WP_FEATURE_EMISSION
@@ -118,12 +185,34 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
   }
 #endif
   /* The paths that scatter: fewer than max_depth events so far. */
-  const uint go = hits & (uint)lane_bits8(bounce < (uint8)(launch.max_depth));
+  uint go = hits & (uint)lane_bits8(bounce < (uint8)(launch.max_depth));
+#endif
+#if WP_FEATURE_GLOSSY
+  /* Those at a surface with a delta lobe, one at a time (lane code has no delta lobes). */
+  for (uint delta = go & (uint)lane_bits8(glossy_delta8(&s)); delta != 0u; delta &= delta - 1u) {
+    const int i = lowest_bit((int)delta);
+    BounceRandom one_u;
+    one_u.light_pick = lane_of(light_pick, i), one_u.lobe = lane_of(lobe_u, i);
+    one_u.roulette = lane_of(roulette_u, i);
+    one_u.light_uv = (float2)(lane_of(light_u, i), lane_of(light_v, i));
+    one_u.bsdf_uv = (float2)(lane_of(bsdf_u, i), lane_of(bsdf_v, i));
+#if WP_SHADE_HITS_BY_LANE
+    const Surface lane_surface = one[i];
+#else
+    const Surface lane_surface = surface_lane(scene, &s, tv[i], i);
+#endif
+    shade_lane(scene, paths, queues, launch, slots[i], &lane_surface, i, lane3(ray_d, i),
+               lane_of(t, i), &one_u, shadow, survives);
+    go &= ~(1u << i);
+  }
+#else
+  (void)lobe_u;
+#endif
   if (go == 0u) return;
-  const float8 cos_o = dot3x8(s.ns, neg3x8(ray_d)); /* bsdf_view */
+  const BsdfView8 v8 = bsdf_view8(&s, neg3x8(ray_d));
   if (launch.strategy != WP_STRATEGY_BSDF && scene->desc->light_count != 0u) {
-    /* The light each path picks (sample_light): a triangle's point in the lanes, any other light
-     * by sample_light_ray itself. */
+    /* The light each path picks (sample_light): a triangle's point in the lanes (untextured
+     * programs without alpha), any other light by sample_light_ray itself. */
     uint ltri[WP_SHADE_LANES], picked[WP_SHADE_LANES], lanes = 0u, env = 0u;
     const bool reuse = scene->desc->light_count <= WP_LIGHT_PICK_REUSE_MAX;
     float8 pmf, rest;
@@ -137,7 +226,9 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
 #endif
     for (int i = 0; i < WP_SHADE_LANES; ++i) {
       const uint4 meta = scene->lights[picked[i]].meta;
-      const bool triangle = meta.x == WP_LIGHT_TRIANGLE;
+      /* sample_triangle8 knows neither emissive textures nor alpha */
+      const bool triangle =
+          meta.x == WP_LIGHT_TRIANGLE && !WP_FEATURE_TEXTURES && !WP_FEATURE_ALPHA;
       ltri[i] = triangle ? meta.y : tri[i];
       if (!((go >> i) & 1u)) continue;
       if (triangle) {
@@ -145,22 +236,26 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
       } else if (meta.x == WP_LIGHT_ENVIRONMENT && uniform_env) {
         lanes |= 1u << i, env |= 1u << i;
       } else {
-        const Surface one = surface_lane(scene, &s, tv[i], i);
-        const BsdfView v = {lane_of(cos_o, i)};
+#if WP_SHADE_HITS_BY_LANE
+        const Surface lane_surface = one[i];
+#else
+        const Surface lane_surface = surface_lane(scene, &s, tv[i], i);
+#endif
+        const BsdfView v = bsdf_view(&lane_surface, -lane3(ray_d, i));
         BounceRandom one_u; /* what sample_light_ray reads of it */
         one_u.light_pick = lane_of(light_pick, i);
         one_u.light_uv = (float2)(lane_of(light_u, i), lane_of(light_v, i));
-        if (sample_light_ray(scene, paths, queues, slots[i], &one, &v, lane_of(t, i), &one_u,
-                             launch.strategy))
+        if (sample_light_ray(scene, paths, queues, slots[i], &lane_surface, &v, lane_of(t, i),
+                             &one_u, launch.strategy))
           *shadow |= 1u << i;
       }
     }
     if (lanes != 0u)
-      *shadow |= sample_light_ray8(scene, paths, queues, slots, lanes, env, &s, cos_o, ray_d, t,
-                                   beta, ltri, pmf, lu, light_v, launch.strategy);
+      *shadow |= sample_light_ray8(scene, paths, queues, slots, lanes, env, &s, &v8, ray_d, t, beta,
+                                   ltri, pmf, lu, light_v, launch.strategy);
   }
-  *survives = sample_next_ray8(paths, queues, launch, slots, go, &s, cos_o, ray_d, t, beta, bounce,
-                               bsdf_u, bsdf_v, roulette_u);
+  *survives |= sample_next_ray8(paths, queues, launch, slots, go, &s, &v8, ray_d, t, beta, bounce,
+                                lobe_u, bsdf_u, bsdf_v, roulette_u);
 }
 #endif
 

@@ -169,9 +169,11 @@ static inline float3 env_map_sample(const SceneView* scene, float2 u, float3* di
   /* The point (u, v) of the map: theta = pi v, phi = 2 pi u - pi, whose cosine and sine are
    * those of 2 pi u with the signs flipped. */
   const float mu = ((float)x + fx) / (float)w, mv = ((float)y + fy) / (float)h;
-  const float2 theta = cos_sin_turn(0.5f * mv), phi = -cos_sin_turn(mu);
-  *dir = env_from_map(d, (float3)(theta.y * phi.y, theta.x, -theta.y * phi.x));
-  *pdf = env_texel_pdf(p_row * p_col, w, h, theta.y);
+  float cos_theta, sin_theta, cos_phi, sin_phi;
+  cos_sin_turn(0.5f * mv, &cos_theta, &sin_theta);
+  cos_sin_turn(mu, &cos_phi, &sin_phi);
+  *dir = env_from_map(d, (float3)(sin_theta * -sin_phi, cos_theta, -sin_theta * -cos_phi));
+  *pdf = env_texel_pdf(p_row * p_col, w, h, sin_theta);
 #if WP_ENV_BILINEAR
   return env_bilinear(scene, mu, mv) * d->env_params.x;
 #else
@@ -205,32 +207,24 @@ static inline float3 env_radiance(const SceneView* scene, float3 dir) {
   return env_radiance_pdf(scene, dir, false, &no_pdf);
 }
 
+/* env_sample_uniform (lane code: util/lanes_begin.def). */
+#define WP_LW 1
+#include "lights/env_uniform.def"
+#if WP_SHADE_PACKET
+#define WP_LW 8
+#include "lights/env_uniform.def"
+#endif
+
 /* Samples a direction toward the environment; returns its radiance, *pdf is the solid-angle
  * density (0 if nothing can be sampled). */
 static inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
 #if WP_FEATURE_ENVIRONMENT
   if (scene->desc->env_width > 0u) return env_map_sample(scene, u, dir, pdf);
 #endif
-  const float z = 1.0f - 2.0f * u.x;
-  const float r = sqrt(fmax(0.0f, 1.0f - z * z));
-  const float2 cs = cos_sin_turn(u.y);
-  *dir = (float3)(r * cs.x, z, r * cs.y);
+  *dir = env_sample_uniform(u.x, u.y);
   *pdf = 1.0f / (4.0f * WP_PI);
   return scene->desc->background.xyz;
 }
-
-#if WP_SHADE_PACKET
-/* env_sample's direction of eight lanes (common.h, Float3x8) for the constant background (no
- * map), whose radiance is the background and pdf 1 / (4 pi) in every lane. */
-WP_LANES_FN Float3x8 env_sample_uniform8(float8 ux, float8 uy) {
-  const float8 z = 1.0f - 2.0f * ux;
-  const float8 r = sqrt(fmax(0.0f, 1.0f - z * z));
-  float8 c, s;
-  cos_sin_turn8(uy, &c, &s);
-  Float3x8 dir = {r * c, z, r * s};
-  return dir;
-}
-#endif
 
 /* The solid-angle density with which env_sample produces dir. */
 static inline float env_pdf(const SceneView* scene, float3 dir) {

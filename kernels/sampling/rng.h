@@ -428,8 +428,8 @@ static inline __attribute__((always_inline)) float8 rng_sobol_bounce(Rng r) {
 /* A bounce's numbers for eight paths (shade_packet.h), lanes being paths: pixel, sample and
  * bounce per lane, seed the render's. What rng_bounce gives path i in its lane j is here lane i
  * of the number for use j -- the same bits, integer arithmetic throughout -- for the uses the
- * Lambertian shading has: the light pick (u[0]), the light point (u[1], u[2]), the BSDF direction
- * (u[3], u[4]) and roulette (u[5]); not the lobe choice. */
+ * shading has: the light pick (u[0]), the light point (u[1], u[2]), the BSDF direction (u[3],
+ * u[4]), roulette (u[5]) and the lobe choice (u[6]). */
 typedef struct RngLanes {
   uint8 pixel, sample, bounce;
   uint seed;
@@ -484,15 +484,17 @@ WP_LANES_FN void rng_pair_lanes(RngOrderLanes o, uint8 pair, bool one_d, float8*
         rng_nested_permute8(dy, wp_hash8(seed ^ (WP_KEY_SECOND + pair * WP_PAIR_KEY_STEP)))));
 }
 
-/* Without `pick` or `roulette` those numbers are left out (0.5 in their place), for shading that
- * does not read them: light picks that reuse the light point's number, no path at the roulette's
- * depth. */
-WP_LANES_FN void rng_bounce_lanes(RngLanes r, float8* u, bool pick, bool roulette) {
+/* Without `pick`, `roulette` or `lobe` those numbers are left out (0.5 in their place), for
+ * shading that does not read them: light picks that reuse the light point's number, no path at the
+ * roulette's depth, a Lambertian BSDF. */
+WP_LANES_FN void rng_bounce_lanes(RngLanes r, float8* u, bool pick, bool roulette, bool lobe) {
   float8 unused;
   const uint8 zero = (uint8)(0u);
-  u[0] = u[5] = (float8)(0.5f);
+  u[0] = u[5] = u[6] = (float8)(0.5f);
   if (pick)
     rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_LIGHT_PICK)), zero, true, &u[0], &unused);
+  if (lobe)
+    rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_BSDF_LOBE)), zero, true, &u[6], &unused);
   if (roulette)
     rng_pair_lanes(rng_order_lanes(r, (uint8)(WP_DIM_ROULETTE)), zero, true, &u[5], &unused);
   /* rng_pair_source, lane by lane */

@@ -69,42 +69,8 @@ static inline int lowest_bit(int bits) {
 static inline float max3(float3 v) {
   return fmax(v.x, fmax(v.y, v.z));
 }
-static inline float luminance(float3 c) {
-  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
-}
-static inline float sqr(float x) {
-  return x * x;
-}
-static inline float pow5(float x) {
-  const float x2 = x * x;
-  return x2 * x2 * x;
-}
 static inline bool all_zero(float3 v) {
   return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f;
-}
-
-/* An orthonormal basis around unit n (tangent t, bitangent b) without branches on the sign of n
- * (the construction of Duff et al. 2017). */
-static inline void make_basis(float3 n, float3* t, float3* b) {
-  const float s = n.z >= 0.0f ? 1.0f : -1.0f;
-  const float a = -1.0f / (s + n.z);
-  const float c = n.x * n.y * a;
-  *t = (float3)(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
-  *b = (float3)(c, s + n.y * n.y * a, -n.y);
-}
-
-/* A ray origin just off a surface point p, on the side of unit normal n, for rays that must not
- * hit the surface they leave. `scale` bounds the magnitudes that went into computing p and into
- * intersecting the surface again (the largest component of |b0 p0| + |b1 p1| + |b2 p2| for a point
- * interpolated from a triangle's vertices: pbrt's error-bound idea): float rounding in both is a
- * small multiple of 2^-24 scale, whatever the ray's angle, so moving the origin by 2^-16 scale
- * along n clears it with a wide margin, at any scene scale and distance from the origin. */
-static inline float offset_distance(float scale) {
-  return scale * (1.0f / 65536.0f);
-}
-
-static inline float3 offset_origin(float3 p, float3 n, float scale) {
-  return p + n * offset_distance(scale);
 }
 
 /* Always inlined: a float8 triple passed to a function kept out of line goes through memory. Not
@@ -242,14 +208,59 @@ WP_LANES_FN Float3x8 normalize3x8(Float3x8 a) {
   }
   return r;
 }
-
-WP_LANES_FN void make_basis8(Float3x8 n, Float3x8* t, Float3x8* b) {
-  const float8 s = select((float8)(-1.0f), (float8)(1.0f), n.z >= 0.0f);
-  const float8 a = -1.0f / (s + n.z);
-  const float8 c = n.x * n.y * a;
-  t->x = 1.0f + s * n.x * n.x * a, t->y = s * c, t->z = -s * n.x;
-  b->x = c, b->y = s + n.y * n.y * a, b->z = -n.y;
+WP_LANES_FN Float3x8 add3x8(Float3x8 a, Float3x8 b) {
+  Float3x8 r = {a.x + b.x, a.y + b.y, a.z + b.z};
+  return r;
 }
+WP_LANES_FN Float3x8 mul3x8(Float3x8 a, Float3x8 b) {
+  Float3x8 r = {a.x * b.x, a.y * b.y, a.z * b.z};
+  return r;
+}
+WP_LANES_FN Float3x8 scale3x8(Float3x8 a, float8 k) {
+  Float3x8 r = {a.x * k, a.y * k, a.z * k};
+  return r;
+}
+#endif
+
+/* The arithmetic of Vec3 in one-path lane code (util/lanes_begin.def), as functions like the
+ * eight-lane add3x8 ...: an operation that is a call at one width is a call at the other, so that
+ * where FP_CONTRACT is on neither fuses a product across it into an addition. */
+static inline float3 add3x1(float3 a, float3 b) {
+  return a + b;
+}
+static inline float3 sub3x1(float3 a, float3 b) {
+  return a - b;
+}
+static inline float3 mul3x1(float3 a, float3 b) {
+  return a * b;
+}
+static inline float3 scale3x1(float3 a, float k) {
+  return a * k;
+}
+
+/* luminance, sqr, pow5 and make_basis (lane code: util/lanes_begin.def). */
+#define WP_LW 1
+#include "util/arith.def"
+#if WP_SHADE_PACKET
+#define WP_LW 8
+#include "util/arith.def"
+#endif
+
+/* A ray origin just off a surface point p, on the side of unit normal n, for rays that must not
+ * hit the surface they leave. `scale` bounds the magnitudes that went into computing p and into
+ * intersecting the surface again (the largest component of |b0 p0| + |b1 p1| + |b2 p2| for a point
+ * interpolated from a triangle's vertices: pbrt's error-bound idea): float rounding in both is a
+ * small multiple of 2^-24 scale, whatever the ray's angle, so moving the origin by 2^-16 scale
+ * along n clears it with a wide margin, at any scene scale and distance from the origin. */
+static inline float offset_distance(float scale) {
+  return scale * (1.0f / 65536.0f);
+}
+
+static inline float3 offset_origin(float3 p, float3 n, float scale) {
+  return p + n * offset_distance(scale);
+}
+
+#if WP_SHADE_PACKET
 WP_LANES_FN float8 offset_distance8(float8 scale) {
   return scale * (1.0f / 65536.0f);
 }

@@ -104,58 +104,12 @@ static inline float log2_poly(float x) {
   return log_poly(x) * WP_LOG2_E;
 }
 
-/* (cos t, sin t) for |t| <= pi/4, by their Taylor polynomials to t^10 and t^9: the remainders are
- * below (pi/4)^12 / 12! = 1.1e-10 and (pi/4)^11 / 11! = 1.8e-9, far under float's rounding, so
- * the result is as good as cos() and sin(), at a fraction of their cost on PoCL (about 13 ns per
- * pair there, with their argument reduction). */
-static inline float2 cos_sin_quarter(float t) {
-  const float t2 = t * t;
-  const float c =
-      1.0f +
-      t2 * (-0.5f + t2 * (1.0f / 24.0f + t2 * (-1.0f / 720.0f +
-                                               t2 * (1.0f / 40320.0f - t2 * (1.0f / 3628800.0f)))));
-  const float s =
-      t * (1.0f + t2 * (-1.0f / 6.0f +
-                        t2 * (1.0f / 120.0f + t2 * (-1.0f / 5040.0f + t2 * (1.0f / 362880.0f)))));
-  return (float2)(c, s);
-}
-
+/* cos_sin_quarter and cos_sin_turn (lane code: util/lanes_begin.def). */
+#define WP_LW 1
+#include "util/cos_sin.def"
 #if WP_SHADE_PACKET
-/* cos_sin_quarter of eight angles (common.h, Float3x8). */
-WP_LANES_FN void cos_sin_quarter8(float8 t, float8* c, float8* s) {
-  const float8 t2 = t * t;
-  *c = 1.0f +
-       t2 * (-0.5f + t2 * (1.0f / 24.0f + t2 * (-1.0f / 720.0f + t2 * (1.0f / 40320.0f -
-                                                                       t2 * (1.0f / 3628800.0f)))));
-  *s = t * (1.0f + t2 * (-1.0f / 6.0f +
-                         t2 * (1.0f / 120.0f + t2 * (-1.0f / 5040.0f + t2 * (1.0f / 362880.0f)))));
-}
-#endif
-
-/* (cos, sin) of the angle 2 pi u for u in [0, 1]: the nearest quarter turn q and the rest t,
- * |t| <= pi/4 (x - q is exact), by cos_sin_quarter, rotated by q quarter turns. No call to the
- * library's cos and sin, whose argument reduction PoCL keeps out of line. */
-static inline float2 cos_sin_turn(float u) {
-  const float x = 4.0f * u;
-  const float q = floor(x + 0.5f);
-  const float2 cs = cos_sin_quarter((x - q) * (0.5f * WP_PI));
-  const int k = (int)q & 3;
-  const float c = k == 0 ? cs.x : k == 1 ? -cs.y : k == 2 ? -cs.x : cs.y;
-  const float s = k == 0 ? cs.y : k == 1 ? cs.x : k == 2 ? -cs.y : -cs.x;
-  return (float2)(c, s);
-}
-
-#if WP_SHADE_PACKET
-/* cos_sin_turn of eight lanes (common.h, Float3x8). */
-WP_LANES_FN void cos_sin_turn8(float8 u, float8* c, float8* s) {
-  const float8 x = 4.0f * u;
-  const float8 q = floor(x + 0.5f);
-  float8 qc, qs;
-  cos_sin_quarter8((x - q) * (0.5f * WP_PI), &qc, &qs);
-  const int8 k = convert_int8(q) & 3;
-  *c = select(select(select(qs, -qc, k == 2), -qs, k == 1), qc, k == 0);
-  *s = select(select(select(-qc, -qs, k == 2), qc, k == 1), qs, k == 0);
-}
+#define WP_LW 8
+#include "util/cos_sin.def"
 #endif
 
 /* cos x for finite x: x in turns less its whole turns (exact), then cos_sin_turn. The turns are off
@@ -163,7 +117,9 @@ WP_LANES_FN void cos_sin_turn8(float8 u, float8* c, float8* s) {
  * grows with |x|: within 4e-7 + 1.2e-7 |x|. */
 static inline float cos_poly(float x) {
   const float t = x * (0.5f * WP_INV_PI);
-  return cos_sin_turn(t - floor(t)).x;
+  float c, s;
+  cos_sin_turn(t - floor(t), &c, &s);
+  return c;
 }
 
 /* atan2(y, x) in [-pi, pi] (an environment map's lookup at every escaped ray took 12% of a render

@@ -22,7 +22,7 @@
 #define WP_PACKET_MASKED_CLOSEST 0
 #endif
 /* The fused shade kernel for eight paths per work-item (integrator/shade_packet.h): the host's
- * choice, for untextured Lambertian scenes. */
+ * choice, for scenes whose BSDF is Lambert's or WP_BSDF_PLAIN's (bsdf/closure.h). */
 #ifndef WP_SHADE_PACKET
 #define WP_SHADE_PACKET 0
 #endif

@@ -6,6 +6,10 @@
  * x axis turned by psi about the normal, t = (cos psi, sin psi, 0), b = n x t. wo and the
  * microfacet normals are taken to the anisotropy frame (t, b, n) for ggx_aniso.h and back, so a
  * turned frame checks that the routines hold for a view out of the (t, n) plane. */
+/* As in the renderer's program, where traversal/traverse.h's FP_CONTRACT OFF comes before the
+ * BSDF: without fused multiply-adds the isotropic routines (lane code, whose vector sums are
+ * calls) and the anisotropic ones (float3 expressions) round alike. */
+#pragma OPENCL FP_CONTRACT OFF
 #include "bsdf/ggx_aniso.h"
 #include "sampling/rng.h"
 
@@ -117,7 +121,7 @@ __kernel void evaluate(__global const float4* a, __global const float4* b, __glo
                   ggx_reflection_pdf(wo.z, w.z, sin2, ax));
   const float3 h = sample_ggx_aniso_visible_normal(wo, ax, ay, u[i]);
   o[3] = (float4)(h, ggx_aniso_reflection_pdf(wo, h, ax, ay));
-  o[4] = (float4)(sample_ggx_visible_normal(wo, ax, u[i]), 0.0f);
+  o[4] = (float4)(sample_ggx_visible_normal(wo, ax, u[i].x, u[i].y), 0.0f);
   const float3 wi = 2.0f * dot(wo, h) * h - wo;
   o[5] = (float4)(wi, ggx_aniso_visibility(wo, wi, ax, ay));
   o[6] = (float4)(ggx_aniso_d(h, ax, ay), ggx_aniso_reflection_pdf(wo, normalize(wo + wi), ax, ay),

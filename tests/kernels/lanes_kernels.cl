@@ -1,9 +1,9 @@
-/* Test kernels of tests/test_sampling.cpp (LaneTwins.*): the eight-lane twins of common.h,
- * elementary.h and sampling/warps.h, which the packet kernels (integrator/shade_packet.h,
- * traverse8_packet.h) use in place of their scalar originals and so must match bit for bit, each
- * beside its original on the same inputs. Built with WP_SHADE_PACKET=1 (the twins exist only
- * there), with and without WP_PREFETCH=1 (the x86 builtins of lane_bits8 and all8, or their
- * generic forms). */
+/* Test kernels of tests/test_sampling.cpp (LaneTwins.*): the eight-lane forms of common.h's
+ * helpers and of the lane code of elementary.h and sampling/warps.h (util/lanes_begin.def), which
+ * the packet kernels (integrator/shade_packet.h, traverse8_packet.h) use in place of the one-path
+ * forms and so must match bit for bit, each beside the one-path form on the same inputs. Built with
+ * WP_SHADE_PACKET=1 (the twins exist only there), with and without WP_PREFETCH=1 (the x86 builtins
+ * of lane_bits8 and all8, or their generic forms). */
 #include "util/common.h"
 #include "sampling/warps.h"
 
@@ -11,7 +11,13 @@
  * each lane's input goes to lanes[8g + i] by the twin and to scalar[8g + i] by the original:
  * 0 length (x), 1 normalize, 2 dot with the vector's yzx (x), 3 cross with it, 4 make_basis of the
  * vector (t; 5: b), 6 cos_sin_turn of w (x, y), 7 sample_cosine_hemisphere at (x, y),
- * 8 offset_origin of the vector along its yzx by scale w. */
+ * 8 offset_origin of the vector along its yzx by scale w, 9 the GGX visible normal from
+ * ggx_view(x, y, w) at alpha ggx_alpha(w) for the numbers (x, y), 10 ggx_d, ggx_visibility and
+ * ggx_reflection_pdf (x, y, z) of numbers made from (x, y, w). */
+/* A direction to the viewer above the normal and a GGX alpha in [0.001, 1] from fractions. */
+#define GGX_VIEW(x, y, w) V3((w)-0.5f, (x)-0.5f, 0.1f + (y))
+#define GGX_ALPHA(w) (0.001f + 0.999f * (w))
+
 __kernel void lane_twins(__global const float4* in, uint groups, uint fn, __global float4* lanes,
                          __global float4* scalar) {
   const uint g = get_global_id(0);
@@ -38,6 +44,14 @@ __kernel void lane_twins(__global const float4* in, uint groups, uint fn, __glob
     cos_sin_turn8(w, &r.x, &r.y);
   } else if (fn == 7u) {
     r = sample_cosine_hemisphere8(x, y);
+  } else if (fn == 9u) {
+#define V3(a, b, c) ((Float3x8){(a), (b), (c)})
+    r = sample_ggx_visible_normal8(normalize3x8(GGX_VIEW(x, y, w)), GGX_ALPHA(w), x, y);
+  } else if (fn == 10u) {
+    r.x = ggx_d8(x, y, GGX_ALPHA(w));
+    r.y = ggx_visibility8(x, y, GGX_ALPHA(w));
+    r.z = ggx_reflection_pdf8(0.01f + x, y, 1.0f - y * y, GGX_ALPHA(w));
+#undef V3
   } else {
     r = offset_origin8(a, b, w);
   }
@@ -58,9 +72,21 @@ __kernel void lane_twins(__global const float4* in, uint groups, uint fn, __glob
       make_basis(p, &t, &bb);
       s.xyz = fn == 4u ? t : bb;
     } else if (fn == 6u) {
-      s.xy = cos_sin_turn(v[i].w);
+      float c, sn;
+      cos_sin_turn(v[i].w, &c, &sn);
+      s.xy = (float2)(c, sn);
     } else if (fn == 7u) {
-      s.xyz = sample_cosine_hemisphere(p.xy);
+      s.xyz = sample_cosine_hemisphere(p.x, p.y);
+    } else if (fn == 9u) {
+#define V3(a, b, c) ((float3)((a), (b), (c)))
+      const float x = p.x, y = p.y, w = v[i].w;
+      s.xyz = sample_ggx_visible_normal(normalize(GGX_VIEW(x, y, w)), GGX_ALPHA(w), x, y);
+    } else if (fn == 10u) {
+      const float x = p.x, y = p.y, w = v[i].w;
+      s.x = ggx_d(x, y, GGX_ALPHA(w));
+      s.y = ggx_visibility(x, y, GGX_ALPHA(w));
+      s.z = ggx_reflection_pdf(0.01f + x, y, 1.0f - y * y, GGX_ALPHA(w));
+#undef V3
     } else {
       s.xyz = offset_origin(p, q, v[i].w);
     }

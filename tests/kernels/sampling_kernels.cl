@@ -262,10 +262,10 @@ inline void draw_other(const Config* c, const SceneView* scene, float2 u, float4
   float3 l;
   float pdf;
   if (c->routine == ST_COSINE) {
-    l = sample_cosine_hemisphere(u);
+    l = sample_cosine_hemisphere(u.x, u.y);
     pdf = cosine_hemisphere_pdf(l.z);
   } else if (c->routine == ST_GGX) {
-    const float3 v = c->a.xyz, h = sample_ggx_visible_normal(v, c->a.w, u);
+    const float3 v = c->a.xyz, h = sample_ggx_visible_normal(v, c->a.w, u.x, u.y);
     l = 2.0f * dot(v, h) * h - v;
     pdf = ggx_reflection_pdf(v.z, h.z, h.x * h.x + h.y * h.y, c->a.w);
   } else {

@@ -6,7 +6,10 @@
 
 __kernel void cos_sin_turn_at(__global const float* u, uint count, __global float2* out) {
   const uint i = get_global_id(0);
-  if (i < count) out[i] = cos_sin_turn(u[i]);
+  if (i >= count) return;
+  float c, s;
+  cos_sin_turn(u[i], &c, &s);
+  out[i] = (float2)(c, s);
 }
 
 __kernel void concentric_disk_at(__global const float2* u, uint count, __global float2* out) {
