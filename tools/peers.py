@@ -409,7 +409,7 @@ def _cycles_world(bpy, sc, scene):
         nt.links.new(env.outputs["Color"], bg.inputs["Color"])
         bg.inputs["Strength"].default_value = scene["env_intensity"]
     else:
-        bg.inputs["Color"].default_value = tuple(scene["env_color"]) + (1.0,)
+        bg.inputs["Color"].default_value = tuple(scene.get("env_color", (0.0, 0.0, 0.0))) + (1.0,)
         bg.inputs["Strength"].default_value = 1.0
     sc.world = world
 
