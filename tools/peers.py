@@ -13,7 +13,8 @@ Run `tools/peers.py --help` for the options. Not part of tools/test.sh: the peer
 libLLVM shared library (DRJIT_LIBLLVM_PATH when set, else the newest
 /usr/lib/x86_64-linux-gnu/libLLVM-*.so*; Debian: libllvm19, with which it was run: with LLVM 15,
 Dr.Jit 1.5's kernels stop with "LLVM ERROR: Cannot select ... fminimum"); bpy 5.0 needs Python
-3.11 (--python). The converter is tools/wavepath_tools/peers_scene.py, tested by tests/test_peers_scene.py.
+3.11 (--python). The converters are tools/wavepath_tools/peers_scene.py (tests/test_peers_scene.py)
+and, for Mitsuba with --pbr, tools/wavepath_tools/peers_pbr.py (tests/test_peers_pbr.py).
 """
 
 import argparse
@@ -30,7 +31,7 @@ import time
 
 TOOLS = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(TOOLS)
-from wavepath_tools import peers_scene  # noqa: E402
+from wavepath_tools import peers_pbr, peers_scene  # noqa: E402
 
 PACKAGES = {"mitsuba": ["mitsuba"], "mitsuba-ld": ["mitsuba"], "cycles": ["bpy"]}
 BASE_PACKAGES = ["numpy", "matplotlib"]
@@ -78,8 +79,9 @@ wavepath too: all three render the same purely Lambertian scene.
              transform Standard, exposure 0 (the EXR is scene-linear anyway). Point lights are
              refused (Blender's watt convention is not verified here).
 
-PBR MODE (--pbr; --renderers wavepath,cycles): the scene is not converted but given to each
-renderer as the glTF file it is, textures and metallic-roughness materials included, optionally
+PBR MODE (--pbr): the scene is given to wavepath and Cycles as the glTF file it is, and
+converted for Mitsuba (tools/wavepath_tools/peers_pbr.py), textures and metallic-roughness
+materials included, optionally
 under an environment map (--env, --env-intensity, --env-rotation, wavepath's options). A file
 without a camera is rendered by both from a copy with wavepath's framing camera written into it
 (tools/wavepath_tools/peers_scene.py: bounds, framing_camera, with_camera; --work/with_camera.glb).
@@ -96,6 +98,29 @@ without a camera is rendered by both from a copy with wavepath's framing camera 
              camera as above, its vectors turned with the importer's axes. Light tree off
              unless --cycles-light-tree (on DamagedHelmet it was slower and noisier; the
              commands that measured it are in docs/peers_helmet.md). Settings otherwise as above.
+  Mitsuba 3  peers_pbr.py (its docstring has the whole table and every gap): world-space PLY
+             meshes (normals, UVs; no tangents: normal maps use dp/du), `principled` BSDF:
+             base colour x texture (sRGB) -> base_color, metallic/roughness x texture B/G
+             (linear) -> metallic/roughness, KHR_materials_ior -> eta, specularFactor -> eta of
+             the scaled F0, transmission -> spec_trans (`principledthin` without
+             KHR_materials_volume), clearcoat -> clearcoat and clearcoat_gloss (GTR1 alpha =
+             roughness^2), sheen -> sheen (white), anisotropy strength -> anisotropic and
+             roughness (same alpha_t, alpha_b); normalTexture -> `normalmap` (scale baked),
+             alphaMode MASK -> `mask` with opacity (alpha >= cutoff) per texel, BLEND -> `mask`
+             with alpha; doubleSided -> `twosided`; emission x texture -> textured `area`
+             emitter; samplers' magFilter and wrapS; KHR_lights_punctual -> `point`, `spot`,
+             `directional`; the environment -> `envmap` with scale --env-intensity and
+             to_world a rotation about +Y by 180 + --env-rotation degrees (Mitsuba's map
+             centre is +Z, wavepath's -Z; checked against wavepath renders of the bare map in
+             six directions). Gaps: Disney's material model (not glTF's), specular colour,
+             sheen colour and roughness, anisotropy rotation, iridescence, dispersion, volume
+             attenuation, mipmaps, wrapT, file tangents, back faces of one-sided materials
+             (black, not culled), spot falloff (linear in angle), light range: each that
+             applies is logged and listed on the page. Refused: KHR_texture_transform, texCoord
+             1, Draco, meshopt, quantized or sparse attributes, instancing, KTX2/WebP, unlit,
+             specular-glossiness. The camera and settings as without --pbr; the `mitsuba`
+             (independent) and `mitsuba-ld` (ldsampler) renderers share one reference, rendered
+             as Cycles' below with the independent sampler.
   Errors     The two do not render the same material model (Blender's Principled BSDF is not
              glTF's BRDF: exact dielectric Fresnel and albedo-scaled diffuse, F82 metals,
              MikkTSpace tangents), so each renderer's relMSE is measured against its own
@@ -181,6 +206,9 @@ def worker_mitsuba(job, scene):
     import mitsuba as mi
     import numpy as np
     mi.set_variant(job["variant"])
+    if scene.get("gltf"):
+        worker_mitsuba_pbr(mi, job, scene)
+        return
     cam = scene["camera"]
     target = [cam["position"][i] + cam["forward"][i] for i in range(3)]
     d = {"type": "scene",
@@ -208,6 +236,18 @@ def worker_mitsuba(job, scene):
         d["light%d" % k] = {"type": "point", "position": light["position"],
                             "intensity": {"type": "rgb", "value": light["intensity"]}}
     img = mi.render(mi.load_dict(d), spp=job["spp"], seed=job["seed"])
+    np.save(job["out"], np.array(img, dtype=np.float64)[:, :, :3])
+
+
+def worker_mitsuba_pbr(mi, job, scene):
+    """--pbr: the scene peers_pbr.convert() made of the glTF (scene["mitsuba"]), seen by
+    scene["camera"], under scene["env"] (see the --help text)."""
+    import numpy as np
+    from wavepath_tools import peers_pbr
+    env = ({"path": scene["env"], "intensity": scene["env_intensity"],
+            "rotation": scene["env_rotation"]} if scene.get("env") else None)
+    d = peers_pbr.mitsuba_scene(scene["mitsuba"], scene["camera"], job, env)
+    img = mi.render(mi.load_dict(peers_pbr.realize(d, mi)), spp=job["spp"], seed=job["seed"])
     np.save(job["out"], np.array(img, dtype=np.float64)[:, :, :3])
 
 
@@ -409,7 +449,7 @@ def _cycles_world(bpy, sc, scene):
         nt.links.new(env.outputs["Color"], bg.inputs["Color"])
         bg.inputs["Strength"].default_value = scene["env_intensity"]
     else:
-        bg.inputs["Color"].default_value = tuple(scene["env_color"]) + (1.0,)
+        bg.inputs["Color"].default_value = tuple(scene.get("env_color", (0.0, 0.0, 0.0))) + (1.0,)
         bg.inputs["Strength"].default_value = 1.0
     sc.world = world
 
@@ -468,8 +508,9 @@ def parse_args(argv):
                         "(default %(default)s)")
     p.add_argument("--pbr", action="store_true",
                    help="render the glTF's own materials (textures, metallic-roughness): Cycles "
-                        "loads the file with Blender's glTF importer; wavepath and cycles only, "
-                        "each measured against its own reference (see PBR MODE below)")
+                        "loads the file with Blender's glTF importer, Mitsuba a conversion "
+                        "(tools/wavepath_tools/peers_pbr.py); each measured against its own "
+                        "reference (see PBR MODE below)")
     p.add_argument("--env", metavar="PATH",
                    help="equirectangular environment map (.hdr, .exr) lighting the scene, "
                         "wavepath's --env (with --pbr only)")
@@ -509,8 +550,6 @@ def parse_args(argv):
         p.error("unknown renderer(s) %s" % ", ".join(bad))
     if a.wavepath_sampler:
         LABELS["wavepath"] = "wavepath (%s sampler)" % a.wavepath_sampler
-    if a.pbr and ("mitsuba" in a.renderers or "mitsuba-ld" in a.renderers):
-        p.error("--pbr: Mitsuba is not converted for glTF materials (--renderers wavepath,cycles)")
     if a.env and not a.pbr:
         p.error("--env needs --pbr (the environment's conversion is verified for that mode only)")
     if a.env and not os.path.isfile(a.env):
@@ -542,6 +581,15 @@ def timed(cmd, env=None):
         sys.exit("peers.py: error: %s failed (%d):\n%s" % (" ".join(cmd), proc.returncode,
                                                           proc.stdout[-4000:]))
     return t, proc.stdout, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def pbr_peers(a):
+    """--pbr: the peers with references of their own: "cycles", and "mitsuba" for either
+    Mitsuba renderer (both samplers converge to one image)."""
+    if not a.pbr:
+        return []
+    return (["mitsuba"] if any(r in a.renderers for r in MITSUBA_SAMPLERS) else []) + (
+        ["cycles"] if "cycles" in a.renderers else [])
 
 
 def cpu_snapshot():
@@ -597,6 +645,13 @@ def convert_pbr(a):
              "env": os.path.abspath(a.env) if a.env else None,
              "env_intensity": a.env_intensity, "env_rotation": a.env_rotation,
              "light_tree": a.cycles_light_tree}
+    if any(r in a.renderers for r in MITSUBA_SAMPLERS):
+        try:
+            scene["mitsuba"] = peers_pbr.convert(a.render_scene, os.path.join(a.work, "mitsuba"))
+        except peers_pbr.ConversionError as e:
+            sys.exit("peers.py: error: Mitsuba: %s" % e)
+        for note in scene["mitsuba"]["notes"]:
+            log("Mitsuba approximates: " + note)
     path = os.path.join(a.work, "scene.json")
     with open(path, "w") as f:
         json.dump(scene, f)
@@ -691,32 +746,38 @@ def reference(a):
     return data["img"], data["var"], float(data["seconds"])
 
 
-def cycles_reference(a, scene_json, env):
-    """--pbr: (image, variance image, seconds) of Cycles' own reference: the mean of --ref-chunks
-    runs of --ref-spp / --ref-chunks samples, seeds 7000, 7001, ...; the variance image is the
-    per-pixel sample variance of the runs over their number. Cached in --work by its settings."""
+def peer_reference(a, peer, scene_json, env):
+    """--pbr: (image, variance image, seconds) of a peer's own reference (peer "cycles" or
+    "mitsuba": Mitsuba's independent sampler, the reference of both Mitsuba renderers): the mean
+    of --ref-chunks runs of --ref-spp / --ref-chunks samples, seeds 7000, 7001, ...; the variance
+    image is the per-pixel sample variance of the runs over their number. Cached in --work by
+    its settings, the peer's version and the code that converts the scene for it."""
+    import inspect
     import numpy as np
     h = hashlib.sha256()
     for f in [a.render_scene] + ([a.env] if a.env else []):
         with open(f, "rb") as fh:
             h.update(fh.read())
     h.update(json.dumps([a.width, a.height, a.ref_spp, a.ref_chunks, a.max_depth, a.rr_depth,
-                         a.env_intensity, a.env_rotation, a.cycles_light_tree,
-                         versions(["cycles"], env)["cycles"]])
+                         a.env_intensity, a.env_rotation, versions([peer], env)[peer]]
+                        + ([a.cycles_light_tree] if peer == "cycles" else [a.mitsuba_variant]))
              .encode())
-    import inspect  # the Cycles worker's code, so that a change to it renders afresh
-    for f in (_cycles_settings, _cycles_camera, _cycles_render, worker_cycles,
-              _cycles_backface_transparent, worker_cycles_gltf, _cycles_gltf_materials,
-              _cycles_world):
+    if peer == "cycles":
+        code = (_cycles_settings, _cycles_camera, _cycles_render, worker_cycles,
+                _cycles_backface_transparent, worker_cycles_gltf, _cycles_gltf_materials,
+                _cycles_world)
+    else:
+        code = (worker_mitsuba, worker_mitsuba_pbr, peers_pbr, peers_scene)
+    for f in code:  # so that a change to the conversion renders afresh
         h.update(inspect.getsource(f).encode())
-    path = os.path.join(a.work, "reference-cycles-%d-%s.npz" % (a.ref_spp, h.hexdigest()[:16]))
+    path = os.path.join(a.work, "reference-%s-%d-%s.npz" % (peer, a.ref_spp, h.hexdigest()[:16]))
     if not os.path.exists(path):
         spp = a.ref_spp // a.ref_chunks
         runs, seconds = [], 0.0
         for k in range(a.ref_chunks):
-            log("reference: cycles, run %d of %d, %d spp, %dx%d" % (k + 1, a.ref_chunks, spp,
-                                                                    a.width, a.height))
-            t, img, _ = run_one(a, "cycles", spp, 7000 + k, scene_json, env, name="ref%d" % k)
+            log("reference: %s, run %d of %d, %d spp, %dx%d" % (peer, k + 1, a.ref_chunks, spp,
+                                                                a.width, a.height))
+            t, img, _ = run_one(a, peer, spp, 7000 + k, scene_json, env, name="ref%d" % k)
             runs.append(img)
             seconds += t
         runs = np.array(runs)
@@ -958,13 +1019,16 @@ def _means_table(a, checks):
     return L
 
 
-def compare_references(refs, masks):
-    """--pbr: the two references against each other, per region ("all", "background",
-    "object"): pixel count, Cycles' mean over wavepath's per channel with 1 s.e. (from both
+PEER_NAMES = {"cycles": "Cycles", "mitsuba": "Mitsuba"}
+
+
+def compare_references(refs, peer, masks):
+    """--pbr: a peer's reference against wavepath's, per region ("all", "background",
+    "object"): pixel count, the peer's mean over wavepath's per channel with 1 s.e. (from both
     variance images), and relMSE = mean(((c - w)^2 - var_c - var_w) / (w^2 + 0.01)), the
     difference beyond both references' noise."""
     import numpy as np
-    (w, wv), (c, cv) = refs["wavepath"], refs["cycles"]
+    (w, wv), (c, cv) = refs["wavepath"], refs[peer]
     regions = {"all": np.ones(w.shape[:2], bool), "background": masks[0], "object": masks[1]}
     out = {}
     for name, m in regions.items():
@@ -981,8 +1045,8 @@ def compare_references(refs, masks):
     return out
 
 
-def references_image(a, refs, path):
-    """--pbr: wavepath's and Cycles' references side by side (linear values clamped to [0, 1],
+def references_image(a, refs, peer, path):
+    """--pbr: wavepath's and a peer's references side by side (linear values clamped to [0, 1],
     sRGB-encoded) and the ratio of their luminances as a map of stops."""
     import matplotlib
     matplotlib.use("Agg")
@@ -994,14 +1058,15 @@ def references_image(a, refs, path):
         return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
 
     lum = np.array([0.2126, 0.7152, 0.0722])
-    w, c = refs["wavepath"][0], refs["cycles"][0]
+    w, c = refs["wavepath"][0], refs[peer][0]
+    name = PEER_NAMES[peer]
     stops = np.log2((c @ lum + 1e-3) / (w @ lum + 1e-3))
     fig, axes = plt.subplots(1, 3, figsize=(12, 4.3), dpi=100)
-    for ax, img, title in ((axes[0], w, "wavepath reference"), (axes[1], c, "Cycles reference")):
+    for ax, img, title in ((axes[0], w, "wavepath reference"), (axes[1], c, name + " reference")):
         ax.imshow(srgb(img), interpolation="nearest")
         ax.set_title(title)
     im = axes[2].imshow(stops, cmap="coolwarm", vmin=-0.5, vmax=0.5, interpolation="nearest")
-    axes[2].set_title("log2(Cycles / wavepath), luminance")
+    axes[2].set_title("log2(%s / wavepath), luminance" % name)
     fig.colorbar(im, ax=axes[2], fraction=0.046, pad=0.04, label="stops")
     for ax in axes:
         ax.set_xticks([])
@@ -1014,25 +1079,29 @@ def references_image(a, refs, path):
     plt.close(fig)
 
 
-def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
-    """The page of a --pbr run."""
+def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other, notes=()):
+    """The page of a --pbr run (notes: the Mitsuba conversion's approximations)."""
     by = _by_renderer(a, rows)
     cmd = "tools/peers.py " + " ".join(a.argv)
     cam_copy = "with_camera" in os.path.basename(a.render_scene)
     env = ("under the environment map `%s` (intensity %g, rotation %g°)"
            % (os.path.relpath(a.env, REPO), a.env_intensity, a.env_rotation) if a.env
            else "with a black background")
+    chunks = ("%%s: %%d spp as the mean of %d runs of %d spp with different seeds (%%.0f s)"
+              % (a.ref_chunks, a.ref_spp // a.ref_chunks))
     refs = "; ".join(
-        {"wavepath": "wavepath: %d spp, one run (%.0f s)",
-         "cycles": "Cycles: %%d spp as the mean of %d runs of %d spp with different seeds "
-                   "(%%.0f s)" % (a.ref_chunks, a.ref_spp // a.ref_chunks)}[r]
-        % (a.ref_spp, ref_info[r]) for r in a.renderers)
-    L = ["# Peer benchmark: wavepath and Cycles on a textured model", "",
+        ["wavepath: %d spp, one run (%.0f s)" % (a.ref_spp, ref_info["wavepath"])]
+        * ("wavepath" in a.renderers)
+        + [chunks % (PEER_NAMES[p] + (" (independent sampler; the reference of both Mitsuba "
+                                      "renderers)" if p == "mitsuba" else ""),
+                     a.ref_spp, ref_info[p]) for p in pbr_peers(a)])
+    peers = " and ".join(PEER_NAMES[p] for p in pbr_peers(a))
+    L = ["# Peer benchmark: wavepath and %s on a textured model" % peers, "",
          "Written by `tools/peers.py --pbr` (see its `--help`); regenerate with", "",
          "    " + cmd, "",
          "Scene `%s` %s, %d × %d, max depth %d scattering events, Russian roulette after %d "
          "(wavepath's); sweep %s samples per pixel; references: %s. Machine: %s, %d cores%s; "
-         "both render on the CPU. Versions: %s."
+         "all render on the CPU. Versions: %s."
          % (os.path.relpath(a.scene, REPO), env, a.width, a.height, a.max_depth, a.rr_depth,
             ", ".join(map(str, a.spp)), refs, _cpu_name(), os.cpu_count(),
             "" if other is None else
@@ -1049,7 +1118,10 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "first), rendering, writing a PFM. Cycles: starting Python and importing `bpy`, "
          "Blender's glTF importer, the scene set-up below, rendering (with Cycles' own BVH "
          "build and texture loading), writing an EXR and reading it back into a NumPy file; "
-         "also after an unmeasured 1-spp run." + _repeat_sentence(a), "",
+         "also after an unmeasured 1-spp run. Mitsuba: starting Python and importing "
+         "`mitsuba`, decoding the textures (Pillow) and loading the converted PLY meshes, "
+         "Dr.Jit's kernels (from its cache, after an unmeasured 1-spp run), rendering, writing "
+         "a NumPy file." + _repeat_sentence(a), "",
          "**Each renderer's error is measured against its own reference** (relMSE = "
          "mean(((x − r)² − var_r) / (r² + 0.01)), tools/wavepath_tools/accuracy_lib.py, with r and var_r that "
          "renderer's reference and its variance image; wavepath's reference is rendered with "
@@ -1100,7 +1172,7 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
          "## Time to reach a relMSE target", "",
          "Interpolated on log-log between the runs around the target; `~`: extrapolated past "
          "the largest run as relMSE ∝ 1/time; `≤`: reached by the smallest run. The ratio is "
-         "Cycles' time over wavepath's (above 1: wavepath is faster).", ""]
+         "the peer's time over wavepath's (above 1: wavepath is faster).", ""]
     L += _time_table(a, by)
     if a.repeat > 1:
         L += ["", "The same by CPU time (user + system seconds, the least of the repetitions): "
@@ -1115,11 +1187,23 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
           "run's sample count (for wavepath's runs, whose default sampler has less error than "
           "independent samples, an overestimate).", "",
           ] + _means_table(a, checks)
-    if ref_cmp:
-        L += ["", "## Conversion check: the two references", "",
-              "Cycles' reference against wavepath's: per channel the ratio of the image means "
-              "(± 1 s.e. from both variance images), and relMSE between the two, (Cycles − "
+    if "mitsuba" in pbr_peers(a):
+        L += ["", "## How Mitsuba is given the scene", "",
+              "`tools/wavepath_tools/peers_pbr.py` converts the glTF for Mitsuba 3 (its "
+              "docstring and `tools/peers.py --help` give the mapping and its gaps): world-space "
+              "PLY meshes with normals and UVs, metallic-roughness on the `principled` BSDF "
+              "(Disney's model: not glTF's, hence Mitsuba's own reference), textures as bitmaps "
+              "decoded in their colour spaces, normal maps through `normalmap`, alpha through "
+              "`mask`, emission as `area` emitters, the environment as `envmap` turned by 180° + "
+              "the rotation to wavepath's orientation. Approximations made on this file:", ""]
+        L += ["- " + n for n in notes] if notes else ["- none"]
+    for peer, cmp in ref_cmp.items():
+        name = PEER_NAMES[peer]
+        L += ["", "## Conversion check: %s's reference against wavepath's" % name, "",
+              "Per channel the ratio of the image means "
+              "(± 1 s.e. from both variance images), and relMSE between the two, (%s − "
               "wavepath)² less both variance images over (wavepath² + 0.01), the difference "
+              % name +
               "beyond the references' noise. Regions from wavepath's depth AOV: *background* are "
               "pixels where every sample missed the model (their 4-neighbours too): they see the "
               "environment map only and test its conversion (orientation, intensity, "
@@ -1128,10 +1212,10 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other):
               "",
               "| region | pixels | R | G | B | ± (1 s.e., largest) | relMSE between references |",
               "|---|---|---|---|---|---|---|"]
-        for name, c in ref_cmp.items():
+        for region, c in cmp.items():
             L.append("| %s | %d | %.4f | %.4f | %.4f | %.2g | %.3g |"
-                     % (name, c["pixels"], *c["ratio"], max(c["se"]), c["rel_mse"]))
-        L += ["", "![the two references and their ratio](%s)" % names["references"]]
+                     % (region, c["pixels"], *c["ratio"], max(c["se"]), c["rel_mse"]))
+        L += ["", "![the two references and their ratio](%s)" % names["references_" + peer]]
     _write_with_notes(a, L)
 
 
@@ -1170,9 +1254,12 @@ def main(argv):
         ref, ref_var, ref_seconds = reference(a)
         refs = {r: (ref, ref_var) for r in a.renderers}
         ref_info = {"wavepath": ref_seconds}
-    if a.pbr and "cycles" in a.renderers:
-        cimg, cvar, ref_info["cycles"] = cycles_reference(a, scene_json, env)
-        refs["cycles"] = (cimg, cvar)
+    for peer in pbr_peers(a):
+        pimg, pvar, ref_info[peer] = peer_reference(a, peer, scene_json, env)
+        for r in a.renderers:
+            if r == peer or MITSUBA_SAMPLERS.get(r) and peer == "mitsuba":
+                refs[r] = (pimg, pvar)
+                ref_info[r] = ref_info[peer]
     rows, checks = [], {}
 
     def score(row, img):
@@ -1241,17 +1328,21 @@ def main(argv):
     page_dir = os.path.dirname(os.path.abspath(a.out))
     if a.pbr:
         names = {"chart": os.path.relpath(chart_path, page_dir)}
-        ref_cmp = None
-        if "cycles" in a.renderers and "wavepath" in a.renderers:
-            ref_cmp = compare_references(refs, background_mask(a))
-            refs_path = base + "_references.png"
-            references_image(a, refs, refs_path)
-            names["references"] = os.path.relpath(refs_path, page_dir)
-            for name, c in ref_cmp.items():
-                log("references, %-10s Cycles / wavepath %s  relMSE %.3g"
-                    % (name, " ".join("%.4f" % x for x in c["ratio"]), c["rel_mse"]))
+        ref_cmp = {}
+        if "wavepath" in a.renderers and pbr_peers(a):
+            masks = background_mask(a)
+            for peer in pbr_peers(a):
+                ref_cmp[peer] = compare_references(refs, peer, masks)
+                refs_path = base + ("_references.png" if peer == "cycles"
+                                    else "_references_%s.png" % peer)
+                references_image(a, refs, peer, refs_path)
+                names["references_" + peer] = os.path.relpath(refs_path, page_dir)
+                for name, c in ref_cmp[peer].items():
+                    log("references, %-10s %s / wavepath %s  relMSE %.3g"
+                        % (name, PEER_NAMES[peer], " ".join("%.4f" % x for x in c["ratio"]),
+                           c["rel_mse"]))
         write_doc_pbr(a, rows, checks, ref_info, ref_cmp, versions(a.renderers, env), names,
-                      other)
+                      other, scene.get("mitsuba", {}).get("notes", []))
     else:
         write_doc(a, rows, checks, ref_seconds, versions(a.renderers, env),
                   os.path.relpath(chart_path, page_dir), (load_before, load_after))
