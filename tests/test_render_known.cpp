@@ -26,6 +26,7 @@
 
 #include "host/device/cl_runtime.h"
 #include "host/device/device_scene.h"
+#include "host/lights/environment.h"
 #include "host/render/render.h"
 #include "host/scene/srgb.h"
 #include "tests/device_test.h"
@@ -721,13 +722,16 @@ struct PacketCase {
   std::size_t wave;
 };
 
-// Renders `s` with shade packets and without for each case: the same film bit for bit.
-void expect_packets_match_single_paths(wp::ClRuntime& runtime, const wp::Scene& s,
-                                       const std::vector<PacketCase>& cases) {
+// Renders `s` with shade packets and without for each case, under `env` where given (else a
+// constant background): the same film bit for bit.
+void expect_packets_match_single_paths(
+    wp::ClRuntime& runtime, const wp::Scene& s, const std::vector<PacketCase>& cases,
+    const std::shared_ptr<const wp::EnvironmentMap>& env = nullptr) {
   for (const auto& [sampler, strategy, wave] : cases) {
     SCOPED_TRACE("sampler " + std::to_string(static_cast<int>(sampler)) + ", strategy " +
                  std::to_string(static_cast<int>(strategy)) + ", wave " + std::to_string(wave));
     wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
+    st.environment = env;
     st.sampler = sampler;
     st.strategy = strategy;
     st.wave_size = wave;
@@ -808,19 +812,35 @@ wp::Scene textured_busy_scene() {
   return s;
 }
 
+// A 16 x 8 environment map: a sky brighter toward the zenith, a dark ground and one bright texel,
+// so that its sampling table is far from uniform (the light samples' binary searches and the
+// bilinear lookups in lanes, kernels/lights/env_map.def).
+std::shared_ptr<const wp::EnvironmentMap> packet_sky() {
+  auto env = std::make_shared<wp::EnvironmentMap>();
+  env->width = 16;
+  env->height = 8;
+  for (int y = 0; y < env->height; ++y)
+    for (int x = 0; x < env->width; ++x) {
+      const float l = (y == 2 && x == 5) ? 40.0f : y < 4 ? 0.2f + 0.1f * float(4 - y) : 0.02f;
+      env->texels.emplace_back(l, 0.8f * l + 0.01f * float(x), 0.6f * l, 0.0f);
+    }
+  wp::build_environment_tables(*env);
+  return env;
+}
+
 // In a scene of Lambertian or plain glTF surfaces (WP_BSDF_PLAIN: bsdf/glossy.def in lanes, delta
 // lobes lane by lane), textured or not, the fused kernel shades eight paths per work-item on PoCL's
 // CPU devices (kernels/integrator/shade_packet.h): the film must be the single-path kernel's bit
-// for bit, with every kind of light sample (the lamp's triangles and the constant background in
-// SIMD lanes, the point light by the single-path function), each sampler and strategy, and several
-// waves of different sizes (which paths share a packet changes nothing). The default suite takes
-// the textured scene under Sobol' and MIS, and the Lambertian one in the cases below;
-// ...Exhaustive (slow) the untextured glossy scene (whose surfaces the lanes resolve) and each
-// sampler and strategy.
+// for bit, with every kind of light sample (the lamp's triangles, the constant background and an
+// environment map in SIMD lanes, the point light by the single-path function), each sampler and
+// strategy, and several waves of different sizes (which paths share a packet changes nothing). The
+// default suite takes the textured scene under the map with Sobol' and MIS, and the Lambertian one
+// in the cases below; ...Exhaustive (slow) the textured scene under a constant background, the
+// untextured glossy scene (whose surfaces the lanes resolve) and each sampler and strategy.
 TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
   using wp::Sampler, wp::Strategy;
   expect_packets_match_single_paths(*runtime_, textured_busy_scene(),
-                                    {{Sampler::kSobol, Strategy::kMis, 1000}});
+                                    {{Sampler::kSobol, Strategy::kMis, 1000}}, packet_sky());
   wp::Scene s = lambert_busy_scene();
   // Rows not a multiple of eight pixels, so that camera-ray packets span two rows (start_paths8
   // counts pixels on from the first one's), and waves of two samples of the image (a packet across
@@ -868,8 +888,9 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
 
 TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilmExhaustive) {
   using wp::Sampler, wp::Strategy;
-  expect_packets_match_single_paths(*runtime_, textured_busy_scene(),
-                                    {{Sampler::kIndependent, Strategy::kMis, 0}});
+  expect_packets_match_single_paths(
+      *runtime_, textured_busy_scene(),
+      {{Sampler::kIndependent, Strategy::kMis, 0}, {Sampler::kSobol, Strategy::kMis, 1000}});
   expect_packets_match_single_paths(*runtime_, glossy_busy_scene(),
                                     {{Sampler::kSobol, Strategy::kMis, 1000},
                                      {Sampler::kSobol, Strategy::kNee, 0},

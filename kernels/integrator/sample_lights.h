@@ -51,9 +51,9 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
 #if WP_SHADE_PACKET
 /* sample_light_ray of eight lanes (common.h, shade_packet.h) for the paths in slots[i] whose bit
  * is set in `lanes`: their light is emissive triangle tri[i], or the constant background where
- * bit i of `env` is set, picked with probability pmf, the point at (ux, uy); surface s (without a
- * delta lobe) seen as v, hit at distance t along ray_d, throughput beta; weighed for `strategy`.
- * Returns the lanes with a shadow ray. */
+ * bit i of `env` is set (with or without a map), picked with probability pmf, the point at (ux,
+ * uy); surface s (without a delta lobe) seen as v, hit at distance t along ray_d, throughput beta;
+ * weighed for `strategy`. Returns the lanes with a shadow ray. */
 WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues queues,
                                    const uint* slots, uint lanes, uint env, const Surface8* s,
                                    const BsdfView8* v, Float3x8 ray_d, float8 t, Float3x8 beta,
@@ -61,11 +61,23 @@ WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues q
                                    uint strategy) {
   LightSample8 ls = sample_triangle8(scene, tri, s->p, ux, uy);
   const int8 sky = ((int8)(1, 2, 4, 8, 16, 32, 64, 128) & (int8)(env)) != 0;
-  if (env != 0u) { /* env_sample without a map */
-    const float3 bg = scene->desc->background.xyz;
-    ls.wi = select3x8(ls.wi, env_sample_uniform8(ux, uy), sky);
-    ls.li = select3x8(ls.li, (Float3x8){bg.x, bg.y, bg.z}, sky);
-    ls.pdf = select(ls.pdf, (float8)(1.0f / (4.0f * WP_PI)), sky);
+  if (env != 0u) { /* env_sample */
+    Float3x8 wi, li;
+    float8 pdf;
+#if WP_FEATURE_ENVIRONMENT
+    if (scene->desc->env_width > 0u) {
+      li = env_map_sample8(scene, ux, uy, &wi, &pdf);
+    } else
+#endif
+    {
+      const float3 bg = scene->desc->background.xyz;
+      wi = env_sample_uniform8(ux, uy);
+      li = (Float3x8){bg.x, bg.y, bg.z};
+      pdf = (float8)(1.0f / (4.0f * WP_PI));
+    }
+    ls.wi = select3x8(ls.wi, wi, sky);
+    ls.li = select3x8(ls.li, li, sky);
+    ls.pdf = select(ls.pdf, pdf, sky);
     ls.dist = select(ls.dist, (float8)(INFINITY), sky);
   }
   ls.pdf *= pmf;

@@ -3,8 +3,8 @@
  * one without extensions (WP_BSDF_PLAIN) (WP_SHADE_PACKET: the host's choice on PoCL's CPU
  * devices, which run a kernel's work-items one after another, so SIMD across paths has to be
  * written out). Each path gets exactly what shade.cl's single-path body gives it: a miss,
- * emission, a light other than a triangle or the constant background, and a surface with a delta
- * lobe go through the same functions lane by lane; the BSDF through its lane code
+ * emission, a punctual light (and a triangle light in textured or alpha programs), and a surface
+ * with a delta lobe go through the same functions lane by lane; the BSDF through its lane code
  * (util/lanes_begin.def: one source for one path and eight); the surface, a triangle light's
  * sample and the next ray through their twins of eight lanes, each beside its original (common.h
  * says why) and computing the same expressions. */
@@ -211,29 +211,26 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
   if (go == 0u) return;
   const BsdfView8 v8 = bsdf_view8(&s, neg3x8(ray_d));
   if (launch.strategy != WP_STRATEGY_BSDF && scene->desc->light_count != 0u) {
-    /* The light each path picks (sample_light): a triangle's point in the lanes (untextured
-     * programs without alpha), any other light by sample_light_ray itself. */
+    /* The light each path picks (sample_light): a triangle's point (in untextured programs
+     * without alpha) and the environment's, with or without a map, in the lanes; any other
+     * light by sample_light_ray itself. */
     uint ltri[WP_SHADE_LANES], picked[WP_SHADE_LANES], lanes = 0u, env = 0u;
     const bool reuse = scene->desc->light_count <= WP_LIGHT_PICK_REUSE_MAX;
     float8 pmf, rest;
     vstore8(pick_light8(scene, reuse ? light_u : light_pick, &pmf, &rest), 0, picked);
     const float8 lu = reuse ? rest : light_u;
-    /* The constant background, sampled in the lanes (no map to look up). */
-#if WP_FEATURE_ENVIRONMENT
-    const bool uniform_env = scene->desc->env_width == 0u;
-#else
-    const bool uniform_env = true;
-#endif
     for (int i = 0; i < WP_SHADE_LANES; ++i) {
       const uint4 meta = scene->lights[picked[i]].meta;
-      /* sample_triangle8 knows neither emissive textures nor alpha */
-      const bool triangle =
-          meta.x == WP_LIGHT_TRIANGLE && !WP_FEATURE_TEXTURES && !WP_FEATURE_ALPHA;
+#if WP_FEATURE_TEXTURES || WP_FEATURE_ALPHA /* which sample_triangle8 knows nothing of */
+      const bool triangle = false;
+#else
+      const bool triangle = meta.x == WP_LIGHT_TRIANGLE;
+#endif
       ltri[i] = triangle ? meta.y : tri[i];
       if (!((go >> i) & 1u)) continue;
       if (triangle) {
         lanes |= 1u << i;
-      } else if (meta.x == WP_LIGHT_ENVIRONMENT && uniform_env) {
+      } else if (meta.x == WP_LIGHT_ENVIRONMENT) {
         lanes |= 1u << i, env |= 1u << i;
       } else {
 #if WP_SHADE_HITS_BY_LANE

@@ -56,21 +56,20 @@
 
 #define WP_ENV_BELOW_ONE 0x1.fffffep-1f /* the largest float below 1 */
 
-/* World direction to the map's frame (inverse rotation), and back. */
+/* World direction to the map's frame (inverse rotation); env_from_map turns it back. */
 static inline float3 env_to_map(const SceneDesc* d, float3 w) {
   const float c = d->env_params.y, s = d->env_params.z;
   return (float3)(c * w.x - s * w.z, w.y, s * w.x + c * w.z);
 }
-static inline float3 env_from_map(const SceneDesc* d, float3 m) {
-  const float c = d->env_params.y, s = d->env_params.z;
-  return (float3)(c * m.x + s * m.z, m.y, -s * m.x + c * m.z);
-}
 
-/* Solid-angle density of a texel chosen with probability p (the product of the table
- * differences) at a point with sin(theta) = sin_theta. */
-static inline float env_texel_pdf(float p, uint w, uint h, float sin_theta) {
-  return sin_theta > 0.0f ? p * ((float)w * (float)h) / (2.0f * WP_PI * WP_PI * sin_theta) : 0.0f;
-}
+/* env_from_map, env_texel_pdf, env_find_interval, env_bilinear and env_map_sample (lane code:
+ * util/lanes_begin.def). */
+#define WP_LW 1
+#include "lights/env_map.def"
+#if WP_SHADE_PACKET
+#define WP_LW 8
+#include "lights/env_map.def"
+#endif
 
 /* The map coordinates (u, v) of map-frame direction m (any length), with r_xz = |m.xz|; theta by
  * atan2, well conditioned at the poles, unlike acos. */
@@ -93,41 +92,6 @@ static inline uint2 env_texel_at(const SceneDesc* d, float2 uv) {
                  min((uint)(uv.y * (float)d->env_height), d->env_height - 1u));
 }
 
-/* The interval of CDF cdf[0..n] holding u: the largest i < n with cdf[i] <= u. When
- * cdf[0] <= u < cdf[n] it is non-empty: cdf[i] <= u < cdf[i+1]. */
-static inline uint env_find_interval(__global const float* cdf, uint n, float u) {
-  uint lo = 0u, hi = n; /* cdf[lo] <= u < cdf[hi] */
-  while (hi - lo > 1u) {
-    const uint mid = (lo + hi) >> 1;
-    if (cdf[mid] <= u)
-      lo = mid;
-    else
-      hi = mid;
-  }
-  return lo;
-}
-
-#if WP_ENV_BILINEAR
-/* The bilinear lookup at map coordinates (u, v) in [0, 1]^2 (see the header comment), unscaled. */
-static inline float3 env_bilinear(const SceneView* scene, float u, float v) {
-  const int w = (int)scene->desc->env_width, h = (int)scene->desc->env_height;
-  const float fx = u * (float)w - 0.5f, fy = v * (float)h - 0.5f;
-  const float x_floor = floor(fx), y_floor = floor(fy);
-  const float tx = fx - x_floor, ty = fy - y_floor;
-  int x0 = (int)x_floor, y0 = (int)y_floor;
-  x0 = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0); /* the seam */
-  const int x1 = x0 + 1 == w ? 0 : x0 + 1;
-  const int y1 = clamp(y0 + 1, 0, h - 1); /* the poles */
-  y0 = clamp(y0, 0, h - 1);
-  __global const float4* r0 = scene->env_texels + y0 * w;
-  __global const float4* r1 = scene->env_texels + y1 * w;
-  const float3 top = mix(r0[x0].xyz, r0[x1].xyz, tx);
-  const float3 bottom = mix(r1[x0].xyz, r1[x1].xyz, tx);
-  return mix(top, bottom, ty);
-}
-
-#endif
-
 /* The map's radiance at map coordinates uv: the filter's lookup, scaled. */
 static inline float3 env_map_radiance_uv(const SceneView* scene, float2 uv) {
 #if WP_ENV_BILINEAR
@@ -149,36 +113,6 @@ static inline float env_map_pdf_uv(const SceneView* scene, float2 uv, float sin_
   const float p =
       (scene->env_marginal[t.y + 1u] - scene->env_marginal[t.y]) * (row[t.x + 1u] - row[t.x]);
   return env_texel_pdf(p, w, d->env_height, sin_theta);
-}
-
-static inline float3 env_map_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
-  const SceneDesc* d = scene->desc;
-  const uint w = d->env_width, h = d->env_height;
-  __global const float* marginal = scene->env_marginal;
-  *dir = (float3)(0.0f, 1.0f, 0.0f);
-  *pdf = 0.0f;
-  if (!(marginal[h] > 0.0f)) return (float3)(0.0f); /* a black map */
-  const float ux = fmin(u.x, WP_ENV_BELOW_ONE), uy = fmin(u.y, WP_ENV_BELOW_ONE);
-  const uint y = env_find_interval(marginal, h, ux);
-  __global const float* row = scene->env_conditional + y * (w + 1u);
-  const uint x = env_find_interval(row, w, uy);
-  const float p_row = marginal[y + 1u] - marginal[y], p_col = row[x + 1u] - row[x];
-  /* Remainders within the chosen intervals: uniform in [0, 1) given the choice. */
-  const float fy = fmin((ux - marginal[y]) / p_row, WP_ENV_BELOW_ONE);
-  const float fx = fmin((uy - row[x]) / p_col, WP_ENV_BELOW_ONE);
-  /* The point (u, v) of the map: theta = pi v, phi = 2 pi u - pi, whose cosine and sine are
-   * those of 2 pi u with the signs flipped. */
-  const float mu = ((float)x + fx) / (float)w, mv = ((float)y + fy) / (float)h;
-  float cos_theta, sin_theta, cos_phi, sin_phi;
-  cos_sin_turn(0.5f * mv, &cos_theta, &sin_theta);
-  cos_sin_turn(mu, &cos_phi, &sin_phi);
-  *dir = env_from_map(d, (float3)(sin_theta * -sin_phi, cos_theta, -sin_theta * -cos_phi));
-  *pdf = env_texel_pdf(p_row * p_col, w, h, sin_theta);
-#if WP_ENV_BILINEAR
-  return env_bilinear(scene, mu, mv) * d->env_params.x;
-#else
-  return scene->env_texels[y * w + x].xyz * d->env_params.x;
-#endif
 }
 
 #endif /* WP_FEATURE_ENVIRONMENT */
@@ -219,7 +153,7 @@ static inline float3 env_radiance(const SceneView* scene, float3 dir) {
  * density (0 if nothing can be sampled). */
 static inline float3 env_sample(const SceneView* scene, float2 u, float3* dir, float* pdf) {
 #if WP_FEATURE_ENVIRONMENT
-  if (scene->desc->env_width > 0u) return env_map_sample(scene, u, dir, pdf);
+  if (scene->desc->env_width > 0u) return env_map_sample(scene, u.x, u.y, dir, pdf);
 #endif
   *dir = env_sample_uniform(u.x, u.y);
   *pdf = 1.0f / (4.0f * WP_PI);

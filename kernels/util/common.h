@@ -220,6 +220,32 @@ WP_LANES_FN Float3x8 scale3x8(Float3x8 a, float8 k) {
   Float3x8 r = {a.x * k, a.y * k, a.z * k};
   return r;
 }
+/* The builtin mix, lane by lane and component by component. */
+WP_LANES_FN Float3x8 mix3x8(Float3x8 a, Float3x8 b, float8 t) {
+  Float3x8 r = {mix(a.x, b.x, t), mix(a.y, b.y, t), mix(a.z, b.z, t)};
+  return r;
+}
+/* p[i] in each lane (lane code's gather, util/lanes_begin.def). */
+WP_LANES_FN float8 gather_float8(__global const float* p, int8 i) {
+  int k[8];
+  float v[8];
+  vstore8(i, 0, k);
+#pragma unroll
+  for (int j = 0; j < 8; ++j) v[j] = p[k[j]];
+  return vload8(0, v);
+}
+/* p[i].xyz in each lane (gather3). */
+WP_LANES_FN Float3x8 gather3_at8(__global const float4* p, int8 i) {
+  int k[8];
+  float4 v[8];
+  vstore8(i, 0, k);
+#pragma unroll
+  for (int j = 0; j < 8; ++j) v[j] = p[k[j]];
+  Float3x8 r;
+  float8 w;
+  transpose4x8(v, &r.x, &r.y, &r.z, &w);
+  return r;
+}
 #endif
 
 /* The arithmetic of Vec3 in one-path lane code (util/lanes_begin.def), as functions like the
