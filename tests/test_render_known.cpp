@@ -723,15 +723,18 @@ struct PacketCase {
 };
 
 // Renders `s` with shade packets and without for each case, under `env` where given (else a
-// constant background): the same film bit for bit.
+// constant background), width x height pixels: the same film bit for bit.
 void expect_packets_match_single_paths(
     wp::ClRuntime& runtime, const wp::Scene& s, const std::vector<PacketCase>& cases,
-    const std::shared_ptr<const wp::EnvironmentMap>& env = nullptr) {
+    const std::shared_ptr<const wp::EnvironmentMap>& env = nullptr, int width = kWidth,
+    int height = kHeight) {
   for (const auto& [sampler, strategy, wave] : cases) {
     SCOPED_TRACE("sampler " + std::to_string(static_cast<int>(sampler)) + ", strategy " +
                  std::to_string(static_cast<int>(strategy)) + ", wave " + std::to_string(wave));
     wp::RenderSettings st = settings_for(s, vec3(0.1f, 0.2f, 0.3f));
     st.environment = env;
+    st.width = width;
+    st.height = height;
     st.sampler = sampler;
     st.strategy = strategy;
     st.wave_size = wave;
@@ -834,13 +837,24 @@ std::shared_ptr<const wp::EnvironmentMap> packet_sky() {
 // for bit, with every kind of light sample (the lamp's triangles, the constant background and an
 // environment map in SIMD lanes, the point light by the single-path function), each sampler and
 // strategy, and several waves of different sizes (which paths share a packet changes nothing). The
-// default suite takes the textured scene under the map with Sobol' and MIS, and the Lambertian one
-// in the cases below; ...Exhaustive (slow) the textured scene under a constant background, the
-// untextured glossy scene (whose surfaces the lanes resolve) and each sampler and strategy.
+// default suite takes the textured scene under the map with Sobol' and MIS (two programs, which
+// the suite's time allows); ...Exhaustive (slow) the Lambertian scene's cases below, the textured
+// scene under a constant background, the untextured glossy scene (whose surfaces the lanes
+// resolve) and each sampler and strategy.
 TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
   using wp::Sampler, wp::Strategy;
+  // Rows not a multiple of eight pixels, so that camera-ray packets span two rows (start_paths8
+  // counts pixels on from the first one's), and waves of two samples of the image (a packet across
+  // the samples' boundary), of 1000 and of 8 paths.
   expect_packets_match_single_paths(*runtime_, textured_busy_scene(),
-                                    {{Sampler::kSobol, Strategy::kMis, 1000}}, packet_sky());
+                                    {{Sampler::kSobol, Strategy::kMis, 2 * 61 * 37},
+                                     {Sampler::kSobol, Strategy::kMis, 1000},
+                                     {Sampler::kSobol, Strategy::kMis, 8}},
+                                    packet_sky(), 61, 37);
+}
+
+// The Lambertian cases of the shade packets (ShadePacketsGiveTheSinglePathFilmExhaustive).
+void expect_lambert_packets_match_single_paths(wp::ClRuntime& runtime) {
   wp::Scene s = lambert_busy_scene();
   // Rows not a multiple of eight pixels, so that camera-ray packets span two rows (start_paths8
   // counts pixels on from the first one's), and waves of two samples of the image (a packet across
@@ -863,9 +877,9 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
     st.height = 37;
     st.spp = 2;
     st.wave_size = wave;
-    const wp::Rendered packets = wp::render(*runtime_, walled, st);
+    const wp::Rendered packets = wp::render(runtime, walled, st);
     st.shade_packets = false;
-    const wp::Rendered single = wp::render(*runtime_, walled, st);
+    const wp::Rendered single = wp::render(runtime, walled, st);
     EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ";
   }
   // Past WP_LIGHT_PICK_REUSE_MAX (64) lights the pick takes a number of its own (lights.h), which
@@ -880,14 +894,15 @@ TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilm) {
   st.sampler = wp::Sampler::kSobol;  // the lanes' numbers (the independent sampler's are per path)
   st.spp = 4;
   st.wave_size = 1000;
-  const wp::Rendered packets = wp::render(*runtime_, s, st);
+  const wp::Rendered packets = wp::render(runtime, s, st);
   st.shade_packets = false;
-  const wp::Rendered single = wp::render(*runtime_, s, st);
+  const wp::Rendered single = wp::render(runtime, s, st);
   EXPECT_TRUE(packets.film.words() == single.film.words()) << "films differ, many lights";
 }
 
 TEST_F(RenderKnown, ShadePacketsGiveTheSinglePathFilmExhaustive) {
   using wp::Sampler, wp::Strategy;
+  expect_lambert_packets_match_single_paths(*runtime_);
   expect_packets_match_single_paths(
       *runtime_, textured_busy_scene(),
       {{Sampler::kIndependent, Strategy::kMis, 0}, {Sampler::kSobol, Strategy::kMis, 1000}});
