@@ -41,13 +41,36 @@ static inline bool background_dark(const SceneView* scene) {
   return !(max3(scene->desc->background.xyz) > 0.0f);
 }
 
+/* The one-path code the packet calls lane by lane for what its lanes do not do is kept out of
+ * line, compiled once: inlined at each call it made the program's build up to twice as long, and
+ * most of these lanes are rare ones (a miss, a delta lobe, a punctual light). */
+#define WP_LANE_BY_LANE static __attribute__((noinline))
+
+/* shade_hit for the path in `slot` (a miss, or a hit the lanes do not resolve). */
+WP_LANE_BY_LANE bool hit_lane(const SceneView* scene, Paths paths, Launch launch, uint slot,
+                              Surface* s) {
+  return shade_hit(scene, paths, launch, slot, s);
+}
+
+/* sample_light_ray for the path in `slot` at surface one, hit at distance t along ray_d, with the
+ * light pick's number and the light point's. */
+WP_LANE_BY_LANE bool light_lane(const SceneView* scene, Paths paths, Queues queues, uint slot,
+                                const Surface* one, float3 ray_d, float t, float light_pick,
+                                float2 light_uv, uint strategy) {
+  const BsdfView v = bsdf_view(one, -ray_d);
+  BounceRandom u; /* what sample_light_ray reads of it */
+  u.light_pick = light_pick;
+  u.light_uv = light_uv;
+  return sample_light_ray(scene, paths, queues, slot, one, &v, t, &u, strategy);
+}
+
 #if WP_FEATURE_GLOSSY
 /* What shade.cl's body does after shade_hit for the path in `slot`, lane i of the packet (surface
  * one, hit at distance t along ray_d, the bounce's numbers u), by the one-path functions: bits i
  * of *shadow and *survives set where it has a shadow ray and a next ray. */
-WP_LANES_FN void shade_lane(const SceneView* scene, Paths paths, Queues queues, Launch launch,
-                            uint slot, const Surface* one, int i, float3 ray_d, float t,
-                            const BounceRandom* u, uint* shadow, uint* survives) {
+WP_LANE_BY_LANE void shade_lane(const SceneView* scene, Paths paths, Queues queues, Launch launch,
+                                uint slot, const Surface* one, int i, float3 ray_d, float t,
+                                const BounceRandom* u, uint* shadow, uint* survives) {
   const BsdfView v = bsdf_view(one, -ray_d);
   if (launch.strategy != WP_STRATEGY_BSDF &&
       sample_light_ray(scene, paths, queues, slot, one, &v, t, u, launch.strategy))
@@ -107,7 +130,7 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
       hits |= 1u << i, first_hit = (uint)i;
     } else if (!dark) {
       Surface unused;
-      (void)shade_hit(scene, paths, launch, slots[i], &unused);
+      (void)hit_lane(scene, paths, launch, slots[i], &unused);
     }
   }
   if (hits == 0u) return;
@@ -166,7 +189,7 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
   Surface one[WP_SHADE_LANES];
   uint go = 0u;
   for (int i = 0; i < n; ++i)
-    if (((hits >> i) & 1u) && shade_hit(scene, paths, launch, slots[i], &one[i])) go |= 1u << i;
+    if (((hits >> i) & 1u) && hit_lane(scene, paths, launch, slots[i], &one[i])) go |= 1u << i;
   if (go == 0u) return;
   for (int i = 0; i < WP_SHADE_LANES; ++i)
     if (!((go >> i) & 1u)) one[i] = one[lowest_bit((int)go)];
@@ -238,12 +261,9 @@ WP_STAGE_FN void shade_packet(const SceneView* scene, Paths paths, Queues queues
 #else
         const Surface lane_surface = surface_lane(scene, &s, tv[i], i);
 #endif
-        const BsdfView v = bsdf_view(&lane_surface, -lane3(ray_d, i));
-        BounceRandom one_u; /* what sample_light_ray reads of it */
-        one_u.light_pick = lane_of(light_pick, i);
-        one_u.light_uv = (float2)(lane_of(light_u, i), lane_of(light_v, i));
-        if (sample_light_ray(scene, paths, queues, slots[i], &lane_surface, &v, lane_of(t, i),
-                             &one_u, launch.strategy))
+        if (light_lane(scene, paths, queues, slots[i], &lane_surface, lane3(ray_d, i),
+                       lane_of(t, i), lane_of(light_pick, i),
+                       (float2)(lane_of(light_u, i), lane_of(light_v, i)), launch.strategy))
           *shadow |= 1u << i;
       }
     }
