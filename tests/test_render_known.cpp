@@ -579,6 +579,9 @@ void expect_deterministic(wp::ClRuntime& runtime, const std::vector<wp::Sampler>
     st.sampler = sampler;
     st.spp = 4;
     st.seed = 11;
+    // Shading one path per work-item: the shade packets' films are the single path's bit for bit
+    // (ShadePacketsGiveTheSinglePathFilm), and each program here would build them too.
+    st.shade_packets = false;
     const wp::Rendered first = wp::render(runtime, s, st);
     const auto& reference = first.image.rgb;
     // The scene has no instances, alpha or transmission, so on PoCL's CPU devices (the wide BVH)
@@ -678,6 +681,7 @@ TEST_F(RenderKnown, ShadowRaysLaunchedAheadAreEachTracedOnce) {
   // rest was launched hung on that timing.)
   st.wave_size = 2 * std::size_t(kWidth) * kHeight;
   st.shadow_ahead = 0.0f;
+  st.shade_packets = false;  // shading one path per work-item, as in expect_deterministic
   const wp::Rendered exact = wp::render(*runtime_, s, st);
   EXPECT_EQ(exact.report.shadow_ahead_launches, 0u);
   const auto& reference = exact.image.rgb;
