@@ -62,10 +62,10 @@ WP_STAGE_FN void sample_next_ray(Paths paths, Queues queues, uint slot, const Su
  * slots[i] whose bit is set in `lanes`, at surfaces without a delta lobe: surface s seen as v,
  * hit at distance t along ray_d, throughput beta, at `bounce`, u_lobe the lobe's number, (ux, uy)
  * the direction's and u_rr roulette's. Returns the lanes that survive roulette. */
-WP_LANES_FN uint sample_next_ray8(Paths paths, Queues queues, Launch launch, const uint* slots,
-                                  uint lanes, const Surface8* s, const BsdfView8* v, Float3x8 ray_d,
-                                  float8 t, Float3x8 beta, uint8 bounce, float8 u_lobe, float8 ux,
-                                  float8 uy, float8 u_rr) {
+WP_LANES_STEP uint sample_next_ray8(Paths paths, Queues queues, Launch launch, const uint* slots,
+                                    uint lanes, const Surface8* s, const BsdfView8* v,
+                                    Float3x8 ray_d, float8 t, Float3x8 beta, uint8 bounce,
+                                    float8 u_lobe, float8 ux, float8 uy, float8 u_rr) {
   float8 pdf;
   int8 valid;
   Float3x8 weight;

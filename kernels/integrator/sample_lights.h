@@ -54,11 +54,11 @@ WP_STAGE_FN bool sample_light_ray(const SceneView* scene, Paths paths, Queues qu
  * bit i of `env` is set (with or without a map), picked with probability pmf, the point at (ux,
  * uy); surface s (without a delta lobe) seen as v, hit at distance t along ray_d, throughput beta;
  * weighed for `strategy`. Returns the lanes with a shadow ray. */
-WP_LANES_FN uint sample_light_ray8(const SceneView* scene, Paths paths, Queues queues,
-                                   const uint* slots, uint lanes, uint env, const Surface8* s,
-                                   const BsdfView8* v, Float3x8 ray_d, float8 t, Float3x8 beta,
-                                   const uint* tri, float8 pmf, float8 ux, float8 uy,
-                                   uint strategy) {
+WP_LANES_STEP uint sample_light_ray8(const SceneView* scene, Paths paths, Queues queues,
+                                     const uint* slots, uint lanes, uint env, const Surface8* s,
+                                     const BsdfView8* v, Float3x8 ray_d, float8 t, Float3x8 beta,
+                                     const uint* tri, float8 pmf, float8 ux, float8 uy,
+                                     uint strategy) {
   LightSample8 ls = sample_triangle8(scene, tri, s->p, ux, uy);
   const int8 sky = ((int8)(1, 2, 4, 8, 16, 32, 64, 128) & (int8)(env)) != 0;
   if (env != 0u) { /* env_sample */

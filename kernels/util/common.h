@@ -83,6 +83,10 @@ static inline bool all_zero(float3 v) {
 #else
 #define WP_LANES_FN static inline __attribute__((always_inline))
 #endif
+/* Out of line: a step of the packet called once per packet (shade_packet.h), whose float8 triples
+ * go through memory once per eight paths. Inlined into the shade kernel with the rest, it made
+ * the plain programs' PoCL build a quarter longer for no speed (docs/performance.md). */
+#define WP_LANES_STEP static __attribute__((noinline))
 
 /* Eight float4 as four float8 of their components, lane i from v[i] (shade, ray packets). */
 WP_LANES_FN void transpose4x8(const float4* v, float8* x, float8* y, float8* z, float8* w) {
