@@ -222,6 +222,36 @@ class Cameras(unittest.TestCase):
             self.assertAlmostEqual(cam["yfov"], math.pi / 4)
             self.assertEqual(cam["aspect"], aspect)
 
+    def test_orbit_camera_is_wavepaths(self):
+        # host/scene/view.cpp, placed_camera: polar angle phi from +Y, azimuth theta from +Z
+        # towards +X, looking at the centre of the bounds; image up towards +Y on the sphere.
+        lo, hi = (0.0, 0.0, 0.0), (2.0, 2.0, 2.0)
+        cam = ps.orbit_camera(lo, hi, 0.0, 90.0, 2.2, 1.0)  # level, from +Z
+        self.assertClose(cam["position"], (1.0, 1.0, 3.2))
+        self.assertClose(cam["forward"], (0.0, 0.0, -1.0))
+        self.assertClose(cam["up"], (0.0, 1.0, 0.0))
+        cam = ps.orbit_camera(lo, hi, 90.0, 60.0, 2.0, 1.0)  # from +X, 30 degrees above
+        s3 = math.sqrt(3.0)
+        self.assertClose(cam["position"], (1.0 + s3, 2.0, 1.0))
+        self.assertClose(cam["forward"], (-s3 / 2, -0.5, 0.0))
+        self.assertClose(cam["up"], (-0.5, s3 / 2, 0.0))
+        self.assertAlmostEqual(sum(f * u for f, u in zip(cam["forward"], cam["up"])), 0.0)
+        # Distance 0 fits the bounding sphere, as the framing camera does.
+        fit = ps.orbit_camera(lo, hi, 0.0, 75.0, 0.0, 0.5)
+        frame = ps.framing_camera(lo, hi, 0.5)
+        for k in ("position", "forward", "up"):
+            self.assertClose(fit[k], frame[k], 1e-12)
+
+    def test_replace_camera(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path, out = os.path.join(tmp, "t.glb"), os.path.join(tmp, "c.glb")
+            self.scene(path, camera=True)
+            cam = ps.orbit_camera(*ps.bounds(path), 30.0, 80.0, 4.0, 1.0)
+            ps.copy_gltf(path, out, [ps.add_camera(cam, replace=True)])
+            got = ps.camera(out)
+            for k in ("position", "forward", "up"):
+                self.assertClose(got[k], cam[k], 1e-12)
+
     def test_with_camera_round_trip(self):
         for ext in (".glb", ".gltf"):
             with tempfile.TemporaryDirectory() as tmp:

@@ -25,6 +25,7 @@ import math
 import os
 import platform
 import re
+import statistics
 import subprocess
 import sys
 import time
@@ -506,6 +507,9 @@ def parse_args(argv):
                         "sample count, the same seeds) and take each run's least wall time: less "
                         "of other work on a shared machine; the page then also gives CPU times "
                         "(default %(default)s)")
+    p.add_argument("--statistic", choices=["least", "median"], default="least",
+                   help="with --repeat: a run's time is the least of its repetitions' (the run "
+                        "least disturbed by other work) or their median (default %(default)s)")
     p.add_argument("--pbr", action="store_true",
                    help="render the glTF's own materials (textures, metallic-roughness): Cycles "
                         "loads the file with Blender's glTF importer, Mitsuba a conversion "
@@ -519,6 +523,10 @@ def parse_args(argv):
     p.add_argument("--env-rotation", type=float, default=0.0,
                    help="rotation of the map about +Y in degrees, wavepath's --env-rotation "
                         "(default 0)")
+    p.add_argument("--orbit", metavar="THETA,PHI,DISTANCE",
+                   help="--pbr: every renderer sees the scene from wavepath's --orbit camera "
+                        "(tools/wavepath_tools/peers_scene.py, orbit_camera), written into a copy "
+                        "of the file in place of its own cameras (--work/orbit.glb or .gltf)")
     p.add_argument("--cycles-light-tree", action="store_true",
                    help="--pbr: Cycles samples lights with its light tree (Blender's default; "
                         "off without this option)")
@@ -548,12 +556,24 @@ def parse_args(argv):
     bad = [r for r in a.renderers if r not in RENDERERS]
     if bad:
         p.error("unknown renderer(s) %s" % ", ".join(bad))
+    for r in MITSUBA_SAMPLERS:
+        LABELS[r] = LABELS[r].replace("llvm_ad_rgb", a.mitsuba_variant)
     if a.wavepath_sampler:
         LABELS["wavepath"] = "wavepath (%s sampler)" % a.wavepath_sampler
     if a.env and not a.pbr:
         p.error("--env needs --pbr (the environment's conversion is verified for that mode only)")
     if a.env and not os.path.isfile(a.env):
         p.error("--env %s: no such file" % a.env)
+    if a.orbit:
+        try:
+            a.orbit = [float(x) for x in a.orbit.split(",")]
+        except ValueError:
+            a.orbit = None
+        if not a.orbit or len(a.orbit) != 3 or a.orbit[2] < 0.0:
+            p.error("--orbit takes THETA,PHI,DISTANCE in degrees, degrees and scene units "
+                    "(distance >= 0; 0 fits the scene)")
+        if not a.pbr:
+            p.error("--orbit needs --pbr")
     if a.repeat < 1:
         p.error("--repeat must be at least 1")
     if (a.nearest_textures or a.no_normal_maps or a.cycles_light_tree) and not a.pbr:
@@ -626,7 +646,11 @@ def convert_pbr(a):
     a.render_scene = a.scene
     cam = peers_scene.camera(a.scene)
     edits, name = [], []
-    if cam is None:
+    if a.orbit:
+        cam = peers_scene.orbit_camera(*peers_scene.bounds(a.scene), *a.orbit, a.width / a.height)
+        edits.append(peers_scene.add_camera(cam, replace=True))
+        name.append("orbit")
+    elif cam is None:
         lo, hi = peers_scene.bounds(a.scene)
         cam = peers_scene.framing_camera(lo, hi, a.width / a.height)
         edits.append(peers_scene.add_camera(cam))
@@ -938,12 +962,14 @@ def _runs_table(a, by, ref_word="reference"):
 def _repeat_sentence(a):
     if a.repeat == 1:
         return ""
-    return (" Each run's time is the least of %d: the sweep was run %d times, the renderers "
+    word = "least" if a.statistic == "least" else "median"
+    return (" Each run's time is the %s of %d: the sweep was run %d times, the renderers "
             "taking turns at each sample count, with the same seeds (so the same images); all "
-            "times are listed under *Every run*, with the least CPU time (user + system seconds "
+            "times are listed under *Every run*, with the %s CPU time (user + system seconds "
             "of the process and its children), which other work on the machine changes much "
-            "less than the wall time. The least wall time is the run least disturbed by other "
-            "work." % (a.repeat, a.repeat))
+            "less than the wall time.%s" % (word, a.repeat, a.repeat, word,
+                                             " The least wall time is the run least disturbed "
+                                             "by other work." if word == "least" else ""))
 
 
 def _write_with_notes(a, L):
@@ -1033,9 +1059,9 @@ def compare_references(refs, peer, masks):
     out = {}
     for name, m in regions.items():
         n = int(m.sum())
-        if n == 0:
-            continue
-        mw, mc = w[m].mean(0), c[m].mean(0)
+        mw, mc = w[m].mean(0) if n else 0.0, c[m].mean(0) if n else 0.0
+        if n == 0 or not np.all(mw > 0.0):
+            continue  # no such pixels, or black ones (the background without --env)
         vw, vc = wv[m].sum(0) / n ** 2, cv[m].sum(0) / n ** 2
         ratio = mc / mw
         se = ratio * np.sqrt(vc / mc ** 2 + vw / mw ** 2)
@@ -1146,7 +1172,10 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other, notes=
          "pixels below). One-pixel box filter, max bounces = max depth − 1 (Cycles counts "
          "bounces after the first hit), no clamping, no filter glossy, no adaptive sampling, no "
          "denoising; Cycles' light tree %s."
-         % ("The file has no camera: both render a copy with wavepath's framing camera "
+         % ("Every renderer sees the scene from wavepath's `--orbit %s` camera (45° vertical "
+            "field of view), written into a copy of the file in place of its own cameras "
+            "(`peers_scene.orbit_camera`). " % ",".join("%g" % x for x in a.orbit) if a.orbit
+            else "The file has no camera: both render a copy with wavepath's framing camera "
             "(45° vertical field of view, the bounding sphere fitted) written into it "
             "(`peers_scene.with_camera`). " if cam_copy else "",
             "on (Blender's default)" if a.cycles_light_tree else
@@ -1175,9 +1204,9 @@ def write_doc_pbr(a, rows, checks, ref_info, ref_cmp, vers, names, other, notes=
          "the peer's time over wavepath's (above 1: wavepath is faster).", ""]
     L += _time_table(a, by)
     if a.repeat > 1:
-        L += ["", "The same by CPU time (user + system seconds, the least of the repetitions): "
+        L += ["", "The same by CPU time (user + system seconds, the %s of the repetitions): "
               "the work each process did on the 2 cores, whatever else was running; with both "
-              "cores busy all along it would be about twice the wall time.", ""]
+              "cores busy all along it would be about twice the wall time." % a.statistic, ""]
         L += _time_table(a, by, "cpu_seconds")
     L += ["", "## Every run", "", "relMSE and image mean against the renderer's own reference.",
           ""] + _runs_table(a, by, "own reference")
@@ -1240,7 +1269,8 @@ def main(argv):
     if a.pbr:
         scene, scene_json = convert_pbr(a)
         log("scene: %s (%s camera), environment %s"
-            % (a.render_scene, "its own" if a.render_scene == a.scene else "wavepath's framing",
+            % (a.render_scene, "--orbit" if a.orbit else "its own" if a.render_scene == a.scene
+               else "wavepath's framing",
                a.env or "black"))
     else:
         scene, scene_json = convert(a)
@@ -1272,8 +1302,8 @@ def main(argv):
         st = al.compare(img, np.zeros_like(img), rimg, rvar)
         row.update(rel_mse=st["rel_mse"], mean_ratio=float(img.mean() / rimg.mean()))
         log("%-8s %5d spp  %7.2f s%s  relMSE %.4g  mean ratio %.4f"
-            % (r, spp, row["seconds"], " (least of %s)" % " ".join(
-                "%.2f" % x for x in row["all_seconds"]) if a.repeat > 1 else "",
+            % (r, spp, row["seconds"], " (%s of %s)" % (a.statistic, " ".join(
+                "%.2f" % x for x in row["all_seconds"])) if a.repeat > 1 else "",
                row["rel_mse"], row["mean_ratio"]))
         if spp == max(a.spp):
             # Var of a channel's image mean, run and reference: sum of pixel variances / n^2.
@@ -1297,7 +1327,7 @@ def main(argv):
         # --repeat: every renderer's warm-up, then the sweep N times, the renderers taking turns
         # at each sample count (so that both meet much the same other work), with the same
         # seeds (the same images: both renderers are deterministic); a run's time is the least
-        # of its repetitions.
+        # (or median: --statistic) of its repetitions.
         for r in a.renderers:
             run_one(a, r, 1, 999, scene_json, env)  # warm-up, not measured: fills kernel caches
         rows = [{"renderer": r, "spp": spp, "all_seconds": [], "all_cpu_seconds": []}
@@ -1313,9 +1343,10 @@ def main(argv):
                     images.setdefault((r, spp), img)
                     log("%-8s %5d spp  %7.2f s  CPU %7.2f s  (repetition %d of %d)"
                         % (r, spp, t, cpu, rep + 1, a.repeat))
+        pick = min if a.statistic == "least" else statistics.median
         for row in rows:
-            row["seconds"] = min(row["all_seconds"])
-            row["cpu_seconds"] = min(row["all_cpu_seconds"])
+            row["seconds"] = pick(row["all_seconds"])
+            row["cpu_seconds"] = pick(row["all_cpu_seconds"])
             score(row, images[(row["renderer"], row["spp"])])
     load_after = os.getloadavg()[0]
     other = other_work(cpu_before, cpu_snapshot(), time.perf_counter() - wall_before)

@@ -474,6 +474,26 @@ def framing_camera(lo, hi, aspect):
             "yfov": yfov, "aspect": aspect}
 
 
+def orbit_camera(lo, hi, theta, phi, distance, aspect, yfov=math.radians(45.0)):
+    """wavepath's --orbit THETA,PHI,DISTANCE camera (host/scene/view.cpp, placed_camera): on the
+    sphere about the centre of the bounds, at polar angle phi from +Y and azimuth theta from +Z
+    towards +X (degrees), looking at the centre, image up towards +Y on that sphere; distance 0
+    fits the bounding sphere (radius half the diagonal) as framing_camera does. As
+    scene["camera"] of load(), with "aspect": aspect."""
+    center = [0.5 * (lo[i] + hi[i]) for i in range(3)]
+    if distance <= 0.0:
+        radius = 0.5 * math.sqrt(sum((hi[i] - lo[i]) ** 2 for i in range(3)))
+        if not radius > 0.0 or not math.isfinite(radius):
+            radius = 1.0
+        half = min(0.5 * yfov, math.atan(math.tan(0.5 * yfov) * aspect))
+        distance = radius / math.sin(half)
+    t, p = math.radians(theta), math.radians(phi)
+    out = (math.sin(p) * math.sin(t), math.cos(p), math.sin(p) * math.cos(t))
+    up = _normalize((-math.cos(p) * math.sin(t), math.sin(p), -math.cos(p) * math.cos(t)))
+    return {"position": tuple(center[i] + distance * out[i] for i in range(3)),
+            "forward": tuple(-c for c in out), "up": up, "yfov": yfov, "aspect": aspect}
+
+
 def camera(path):
     """The camera wavepath renders a file with by default (its first), as scene["camera"] of
     load(); None when the file has none. ConversionError for a camera that is not perspective."""
@@ -552,10 +572,15 @@ def copy_gltf(path, out, edits):
         fh.write(struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks)
 
 
-def add_camera(cam):
+def add_camera(cam, replace=False):
     """An edit for copy_gltf: `cam` (a dict like scene["camera"]; znear 0.001) as the document's
-    one camera, on a new root node; ValueError for a document with cameras."""
+    one camera, on a new root node; ValueError for a document with cameras, unless `replace`,
+    which takes the file's own cameras off their nodes first."""
     def edit(doc):
+        if doc.get("cameras") and replace:
+            for node in doc.get("nodes", []):
+                node.pop("camera", None)
+            doc.pop("cameras")
         if doc.get("cameras"):
             raise ValueError("add_camera: the file has cameras already")
         f, u = _normalize(cam["forward"]), _normalize(cam["up"])
