@@ -6,7 +6,7 @@
 
 Without PyPI: the mapping of each material parameter onto Mitsuba's principled BSDF (and its
 twosided, normalmap and mask wrappers), the textures' channels and colour spaces, the samplers,
-node transforms of the PLY meshes written (positions, normals, winding, the v flip), punctual
+node transforms of the PLY meshes written (positions, normals, winding, the texture coordinates), punctual
 lights, the environment's orientation (wavepath's env_dir_uv against Mitsuba's envmap lookup,
 in Python), and the refusals. With NumPy and Pillow (Debian's python3-numpy, python3-pil): the
 texture data baked from a PNG (sRGB decoding, factors, the MASK cut-off, the normal scale).
@@ -236,14 +236,16 @@ class Refusals(unittest.TestCase):
 class Geometry(unittest.TestCase):
     def test_transform_normals_winding_and_uvs(self):
         # Mirror x and scale y by 2 (matrix, column-major): positions, normals (inverse
-        # transpose, unit), the winding reversed, v written as 1 - v for Mitsuba's PLY reader.
+        # transpose, unit), the winding reversed, the texture coordinates as they are (Mitsuba's
+        # PLY reader keeps them and its bitmaps put v = 0 at the top row, as glTF does:
+        # WithMitsuba.test_texture_coordinates_are_gltfs).
         doc = document(matrix=(-1, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1, 0, 3, 0, 0, 1))
         with tempfile.TemporaryDirectory() as tmp:
             desc = convert(doc, tmp)
             props, verts, tris = read_ply(desc["shapes"][0]["ply"])
         self.assertEqual(props, ["x", "y", "z", "nx", "ny", "nz", "u", "v"])
-        for got, want in zip(verts, [(3, 0, 0, 0, 0, 1, 0, 1), (2, 0, 0, 0, 0, 1, 1, 1),
-                                     (3, 2, 0, 0, 0, 1, 0, 0)]):
+        for got, want in zip(verts, [(3, 0, 0, 0, 0, 1, 0, 0), (2, 0, 0, 0, 0, 1, 1, 0),
+                                     (3, 2, 0, 0, 0, 1, 0, 1)]):
             for g, w in zip(got, want):
                 self.assertAlmostEqual(g, w, places=6)
         self.assertEqual(tris, [(0, 2, 1)])
@@ -373,6 +375,32 @@ class WithMitsuba(unittest.TestCase):
             d = pp.realize(pp.mitsuba_scene(desc, CAM, JOB), mi)
             img = np.array(mi.render(mi.load_dict(d), spp=4))
         self.assertEqual(img.shape[:2], (6, 8))
+
+    def test_texture_coordinates_are_gltfs(self):
+        # A ray hitting the converted triangle at (0.1, 0.6) finds glTF's uv there, (0.1, 0.6)
+        # (the triangle's uv is its (x, y)), and a Mitsuba bitmap looks v < 0.5 up in its top
+        # row, as glTF does: so the converted texture shows the texel glTF names. (Written as
+        # 1 - v, DamagedHelmet's textures came out mirrored: a metal visor without its lights.)
+        import mitsuba as mi
+        import numpy as np
+        mi.set_variant("scalar_rgb")
+        with tempfile.TemporaryDirectory() as tmp:
+            desc = convert(document(), tmp)
+            scene = mi.load_dict({"type": "scene", "s": {"type": "ply",
+                                                         "filename": desc["shapes"][0]["ply"]}})
+            si = scene.ray_intersect(mi.Ray3f(mi.Point3f(0.1, 0.6, 1.0),
+                                              mi.Vector3f(0.0, 0.0, -1.0)))
+            self.assertAlmostEqual(si.uv[0], 0.1, places=5)
+            self.assertAlmostEqual(si.uv[1], 0.6, places=5)
+        img = np.zeros((2, 2, 3), np.float32)
+        img[0, :, 0] = 1.0  # top row red, bottom row blue
+        img[1, :, 2] = 1.0
+        tex = mi.load_dict({"type": "bitmap", "bitmap": mi.Bitmap(img), "raw": True,
+                            "filter_type": "nearest"})
+        probe = mi.SurfaceInteraction3f()
+        for v, want in ((0.1, (1.0, 0.0, 0.0)), (0.9, (0.0, 0.0, 1.0))):
+            probe.uv = mi.Point2f(0.25, v)
+            self.assertEqual(tuple(float(c) for c in tex.eval(probe)), want)
 
 
 @unittest.skipUnless(os.path.isdir(os.path.join(ASSETS, "models")), "needs ../shared/assets")

@@ -22,7 +22,7 @@ primitives that are not triangles, cameras that are not perspective.
 Geometry: every triangle primitive of the default scene becomes one binary PLY in world space
 (node transforms applied; normals by the inverse transpose; a mirroring transform reverses the
 winding, as in peers_scene.load), with its NORMAL (else flat shading: face_normals) and
-TEXCOORD_0 (written as v' = 1 - v: Mitsuba's PLY reader flips v, and its bitmaps put v = 0 at the
+TEXCOORD_0 (written as it is: Mitsuba's PLY reader keeps it, and its bitmaps put v = 0 at the
 image's top row, glTF's convention). TANGENT is not used: Mitsuba has no vertex tangents; its
 normal maps use the frame of dp/du (from the UVs, per triangle) and cross(n, dp/du).
 
@@ -483,8 +483,8 @@ def primitive(doc, buffers, prim, world, where):
 
 
 def write_ply(path, mesh):
-    """One primitive as binary little-endian PLY: x y z [nx ny nz] [u v] floats (v flipped for
-    Mitsuba's reader, which flips it back), uint32 triangle lists."""
+    """One primitive as binary little-endian PLY: x y z [nx ny nz] [u v] floats (glTF's u, v:
+    Mitsuba reads them as they are), uint32 triangle lists."""
     import struct
     from array import array
     props = ["x", "y", "z"]
@@ -503,7 +503,7 @@ def write_ply(path, mesh):
             values.extend(mesh["normals"][k])
         if mesh["uvs"] is not None:
             u, v = mesh["uvs"][k]
-            values.extend((u, 1.0 - v))
+            values.extend((u, v))
     if values.itemsize != 4 or struct.pack("=f", 1.0) != struct.pack("<f", 1.0):
         raise RuntimeError("write_ply needs 4-byte little-endian floats")
     with open(path, "wb") as f:
