@@ -104,9 +104,8 @@ def parse_args(argv):
     p.add_argument("--quick", action="store_true",
                    help="a smoke run of the whole chain: 64 x 64, spp 4,16, references of 64 "
                         "spp, no repetition, into build/peer-suite-quick/ (page included)")
-    p.add_argument("--venv", default=os.path.join(REPO, "build", "peers-venv"),
-                   help="tools/peers.py's --venv")
-    p.add_argument("--python", default=sys.executable, help="tools/peers.py's --python")
+    p.add_argument("--venv", help="tools/peers.py's --venv (default: its own, build/peers-venv)")
+    p.add_argument("--python", help="tools/peers.py's --python (default: its own)")
     a = p.parse_args(argv)
     a.scenes = [s for s in a.scenes.split(",") if s]
     bad = [s for s in a.scenes if s not in keys]
@@ -148,14 +147,19 @@ def commit():
 def peers_command(a, scene, size):
     key, path, extra, _ = scene
     name = entry_key(key, size)
-    return ([sys.executable, os.path.join(TOOLS, "peers.py"), "--pbr", "--scene", path,
+
+    def rel(p):  # the pages show the command: paths from the repository's root, where it runs
+        return os.path.relpath(p, REPO)
+    venv = ["--venv", a.venv] if a.venv else []
+    python = ["--python", a.python] if a.python else []
+    return ([sys.executable, "tools/peers.py", "--pbr", "--scene", rel(path),
              "--width", str(size[0]), "--height", str(size[1]), "--spp", a.spp,
              "--ref-spp", str(a.ref_spp), "--repeat", str(a.repeat), "--statistic", "median",
              "--ref-chunks", "8" if a.ref_spp % 8 == 0 else "2",
-             "--renderers", ",".join(a.renderers), "--venv", a.venv, "--python", a.python,
-             "--work", os.path.join(a.work, name),
-             "--out", os.path.join(os.path.dirname(a.out), "peers_suite", name + ".md")]
-            + extra)
+             "--renderers", ",".join(a.renderers)] + venv + python
+            + ["--work", rel(os.path.join(a.work, name)),
+               "--out", rel(os.path.join(os.path.dirname(a.out), "peers_suite", name + ".md"))]
+            + [rel(x) if x.endswith(".hdr") else x for x in extra])
 
 
 def summarize(rows, width, height):
@@ -181,7 +185,7 @@ def run_entry(a, scene, size):
     work = os.path.join(a.work, name)
     cmd = peers_command(a, scene, size)
     log("%s: %s" % (name, " ".join(cmd[1:])))
-    proc = subprocess.run(cmd)
+    proc = subprocess.run(cmd, cwd=REPO)
     if proc.returncode != 0:
         log("%s: tools/peers.py failed (%d); the entry is left unmeasured"
             % (name, proc.returncode))
