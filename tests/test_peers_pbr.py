@@ -8,9 +8,11 @@ Without PyPI: the mapping of each material parameter onto Mitsuba's principled B
 twosided, normalmap and mask wrappers), the textures' channels and colour spaces, the samplers,
 node transforms of the PLY meshes written (positions, normals, winding, the texture coordinates), punctual
 lights, the environment's orientation (wavepath's env_dir_uv against Mitsuba's envmap lookup,
-in Python), and the refusals. With NumPy and Pillow (Debian's python3-numpy, python3-pil): the
+in Python), KHR_texture_transform's matrix and its to_uv on every texture slot, and the
+refusals. With NumPy and Pillow (Debian's python3-numpy, python3-pil): the
 texture data baked from a PNG (sRGB decoding, factors, the MASK cut-off, the normal scale).
-With Mitsuba: the realised dict loads and evaluates. With ../shared/assets: the sample models
+With Mitsuba: the realised dict loads and evaluates, and a transformed bitmap looks up the texel
+glTF's transform names. With ../shared/assets: the sample models
 convert. Each of those skips, not fails, where its packages or files are absent.
 """
 
@@ -74,12 +76,12 @@ def document(material=None, extensions_used=(), uvs=True, **node):
     return doc
 
 
-def convert(doc, tmp):
+def convert(doc, tmp, texels=TEXELS):
     path = os.path.join(tmp, "t.gltf")
     with open(path, "w") as f:
         json.dump(doc, f)
     with open(os.path.join(tmp, "tex.png"), "wb") as f:
-        f.write(png(TEXELS))
+        f.write(png(texels))
     return pp.convert(path, os.path.join(tmp, "work"))
 
 
@@ -212,10 +214,14 @@ class Refusals(unittest.TestCase):
             with self.assertRaisesRegex(pp.ConversionError, pattern):
                 convert(doc, tmp)
 
-    def test_texture_transform(self):
-        self.refused("KHR_texture_transform", {"pbrMetallicRoughness": {"baseColorTexture": {
-            "index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}}})
-        self.refused("KHR_texture_transform", extensions_used=["KHR_texture_transform"])
+    def test_texture_transform_texcoord_override(self):
+        # KHR_texture_transform converts (TextureTransform), but its texCoord override names
+        # the UV set looked up, and only TEXCOORD_0 converts.
+        self.refused("KHR_texture_transform texCoord 1", {"pbrMetallicRoughness": {
+            "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+                "scale": [2, 2], "texCoord": 1}}}}}, ["KHR_texture_transform"])
+        self.refused("KHR_texture_transform texCoord 1", {"normalTexture": {
+            "index": 0, "texCoord": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1}}}})
 
     def test_second_uv_set(self):
         self.refused("texCoord 1", {"normalTexture": {"index": 0, "texCoord": 1}})
@@ -231,6 +237,89 @@ class Refusals(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             with self.assertRaisesRegex(pp.ConversionError, "EXT_made_up"):
                 convert(doc, tmp)
+
+
+class TextureTransform(unittest.TestCase):
+    def assert_maps(self, m, uv, want):
+        got = [m[i][0] * uv[0] + m[i][1] * uv[1] + m[i][2] for i in range(2)]
+        self.assertEqual([row[:] for row in m[2:]], [[0.0, 0.0, 1.0]])
+        for g, w in zip(got, want):
+            self.assertAlmostEqual(g, w, places=12, msg=(uv, got, want))
+
+    def test_matrix(self):
+        # offset (0.25, 0.5), rotation pi/2, scale (2, 3): S (u, v) = (2u, 3v); R turns the
+        # UVs counter-clockwise (rows (c, s), (-s, c)): (x, y) -> (y, -x); then T: + offset.
+        # So (u, v) -> (3v + 0.25, -2u + 0.5).
+        m = pp.uv_transform({"offset": [0.25, 0.5], "rotation": math.pi / 2, "scale": [2, 3]})
+        for uv, want in (((0, 0), (0.25, 0.5)), ((1, 0), (0.25, -1.5)), ((0, 1), (3.25, 0.5)),
+                         ((0.5, 0.5), (1.75, -0.5)), ((0.1, 0.05), (0.4, 0.3))):
+            self.assert_maps(m, uv, want)
+
+    def test_extension_example(self):
+        # The extension's own example: offset (0, 1), rotation pi/2, scale 0.5 uses "only the
+        # lower left quadrant of the source image, rotated clockwise 90 degrees" (v = 0 at the
+        # top): (u, v) -> (v / 2, 1 - u / 2).
+        m = pp.uv_transform({"offset": [0, 1], "rotation": math.pi / 2, "scale": [0.5, 0.5]})
+        for uv, want in (((0, 0), (0, 1)), ((1, 0), (0, 0.5)), ((0, 1), (0.5, 1)),
+                         ((1, 1), (0.5, 0.5))):
+            self.assert_maps(m, uv, want)
+        # flipping T: offset (0, 1), scale (1, -1): (u, v) -> (u, 1 - v)
+        self.assert_maps(pp.uv_transform({"offset": [0, 1], "scale": [1, -1]}), (0.2, 0.3),
+                         (0.2, 0.7))
+        self.assertEqual(pp.uv_transform({}), pp.IDENTITY3)
+
+    def test_every_slot_carries_to_uv(self):
+        def xf(k, **extra):
+            return dict({"index": k % 2, "extensions": {"KHR_texture_transform": {
+                "offset": [0.1 * k, 0.0], "scale": [2, 2]}}}, **extra)
+        desc = one_material({
+            "alphaMode": "MASK", "doubleSided": True,
+            "pbrMetallicRoughness": {"baseColorTexture": xf(1), "metallicRoughnessTexture": xf(2)},
+            "normalTexture": xf(3, scale=0.5), "emissiveFactor": [1, 1, 1],
+            "emissiveTexture": xf(4),
+            "extensions": {"KHR_materials_clearcoat": {
+                "clearcoatFactor": 1.0, "clearcoatTexture": xf(5),
+                "clearcoatRoughnessTexture": xf(6)}}}, ["KHR_texture_transform"])
+        mat = desc["materials"][0]
+        mask = mat["bsdf"]
+        normal = mask["bsdf"]["normalmap"]
+        p = mask["bsdf"]["bsdf"]["bsdf"]
+        slots = {"alpha": (mask["opacity"], 1), "base_color": (p["base_color"], 1),
+                 "metallic": (p["metallic"], 2), "roughness": (p["roughness"], 2),
+                 "normal": (normal, 3), "emission": (mat["emitter"]["radiance"], 4),
+                 "clearcoat": (p["clearcoat"], 5), "clearcoat_gloss": (p["clearcoat_gloss"], 6)}
+        for name, (tex, k) in slots.items():
+            self.assertEqual(tex["to_uv"], {"peers_to_uv": [[2.0, 0.0, 0.1 * k],
+                                                            [0.0, 2.0, 0.0],
+                                                            [0.0, 0.0, 1.0]]}, name)
+        # one image, three transforms: each bitmap its own to_uv (not shared dicts)
+        self.assertIsNot(p["base_color"]["to_uv"], normal["to_uv"])
+        self.assertEqual(p["base_color"]["peers"]["image"], normal["peers"]["image"])
+        self.assertNotIn("KHR_texture_transform", " ".join(desc["notes"]))
+
+    def test_identity_and_plain_textures_have_no_to_uv(self):
+        b = one_material({"pbrMetallicRoughness": {
+            "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+                "texCoord": 0}}},
+            "metallicRoughnessTexture": {"index": 1}}})["materials"][0]["bsdf"]
+        self.assertNotIn("to_uv", b["base_color"])
+        self.assertNotIn("to_uv", b["metallic"])
+
+    def test_override_zero_replaces_texcoord(self):
+        b = one_material({"pbrMetallicRoughness": {"baseColorTexture": {
+            "index": 0, "texCoord": 1, "extensions": {"KHR_texture_transform": {
+                "rotation": 0.5, "texCoord": 0}}}}})["materials"][0]["bsdf"]
+        self.assertIn("to_uv", b["base_color"])
+
+    def test_required_extension_converts(self):
+        doc = document({"pbrMetallicRoughness": {"baseColorTexture": {
+            "index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}}},
+            ["KHR_texture_transform"])
+        doc["extensionsRequired"] = ["KHR_texture_transform"]
+        with tempfile.TemporaryDirectory() as tmp:
+            desc = convert(doc, tmp)
+        self.assertEqual(desc["materials"][0]["bsdf"]["base_color"]["to_uv"]["peers_to_uv"][0],
+                         [2.0, 0.0, 0.0])
 
 
 class Geometry(unittest.TestCase):
@@ -402,11 +491,52 @@ class WithMitsuba(unittest.TestCase):
             probe.uv = mi.Point2f(0.25, v)
             self.assertEqual(tuple(float(c) for c in tex.eval(probe)), want)
 
+    def test_texture_transform_picks_gltfs_texel(self):
+        # A 4 x 4 image, texel (column c, row r; row 0 the top) of colour (30 + 60 c, 30 + 60 r,
+        # 128), as baseColorTexture (sRGB) with nearest filtering. glTF looks uv up at
+        # (u', v') = M (u, v, 1), texel (floor(4 u'), floor(4 v')) (wrapped). Worked by hand:
+        #   offset (0.25, 0.5), rotation pi/2, scale (2, 3), REPEAT: (u', v') = (3v + 0.25,
+        #   -2u + 0.5); uv (0.1, 0.05) -> (0.4, 0.3): texel (1, 1); (0.3, 0.2) -> (0.85, -0.1),
+        #   v' wraps to 0.9: texel (3, 3); (0.05, 0.3) -> (1.15, 0.4), u' wraps to 0.15:
+        #   texel (0, 1); (0.35, 0.1) -> (0.55, -0.2) -> (0.55, 0.8): texel (2, 3).
+        #   The extension's example, offset (0, 1), rotation pi/2, scale 0.5, CLAMP:
+        #   (u', v') = (v / 2, 1 - u / 2); uv (0.1, 0.9) -> (0.45, 0.95): texel (1, 3);
+        #   (0.9, 0.2) -> (0.1, 0.55): texel (0, 2); (0.6, 0.7) -> (0.35, 0.7): texel (1, 2).
+        import mitsuba as mi
+        mi.set_variant("scalar_rgb")
+        texels = [[(30 + 60 * c, 30 + 60 * r, 128, 255) for c in range(4)] for r in range(4)]
+
+        def linear(byte):
+            x = byte / 255.0
+            return x / 12.92 if x <= 0.04045 else ((x + 0.055) / 1.055) ** 2.4
+
+        cases = (({"offset": [0.25, 0.5], "rotation": math.pi / 2, "scale": [2, 3]}, 10497,
+                  [((0.1, 0.05), (1, 1)), ((0.3, 0.2), (3, 3)), ((0.05, 0.3), (0, 1)),
+                   ((0.35, 0.1), (2, 3))]),
+                 ({"offset": [0, 1], "rotation": math.pi / 2, "scale": [0.5, 0.5]}, 33071,
+                  [((0.1, 0.9), (1, 3)), ((0.9, 0.2), (0, 2)), ((0.6, 0.7), (1, 2))]))
+        for xf, wrap, points in cases:
+            doc = document({"pbrMetallicRoughness": {"baseColorTexture": {
+                "index": 0, "extensions": {"KHR_texture_transform": xf}}}},
+                ["KHR_texture_transform"])
+            doc["samplers"] = [{"magFilter": 9728, "wrapS": wrap, "wrapT": wrap}]
+            with tempfile.TemporaryDirectory() as tmp:
+                desc = convert(doc, tmp, texels)
+                tex = mi.load_dict(pp.realize(desc["materials"][0]["bsdf"]["base_color"], mi))
+            probe = mi.SurfaceInteraction3f()
+            for uv, (c, r) in points:
+                probe.uv = mi.Point2f(*uv)
+                want = [linear(v) for v in texels[r][c][:3]]
+                got = [float(x) for x in tex.eval(probe)]
+                for g, w in zip(got, want):
+                    self.assertAlmostEqual(g, w, places=5, msg=(xf, uv, (c, r), got, want))
+
 
 @unittest.skipUnless(os.path.isdir(os.path.join(ASSETS, "models")), "needs ../shared/assets")
 class SampleModels(unittest.TestCase):
     def test_convert(self):
-        for name in ("BoxTextured/BoxTextured.glb", "DamagedHelmet/DamagedHelmet.glb"):
+        for name in ("BoxTextured/BoxTextured.glb", "DamagedHelmet/DamagedHelmet.glb",
+                     "SheenChair/SheenChair.gltf", "ClearCoatCarPaint/ClearCoatCarPaint.glb"):
             path = os.path.join(ASSETS, "models", name)
             if not os.path.exists(path):
                 continue

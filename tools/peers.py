@@ -117,8 +117,8 @@ without a camera is rendered by both from a copy with wavepath's framing camera 
              sheen colour and roughness, anisotropy rotation, iridescence, dispersion, volume
              attenuation, mipmaps, wrapT, file tangents, back faces of one-sided materials
              (black, not culled), spot falloff (linear in angle), light range: each that
-             applies is logged and listed on the page. Refused: KHR_texture_transform, texCoord
-             1, Draco, meshopt, quantized or sparse attributes, instancing, KTX2/WebP, unlit,
+             applies is logged and listed on the page. KHR_texture_transform -> the bitmap's
+             to_uv. Refused: texCoord 1, Draco, meshopt, quantized or sparse attributes, instancing, KTX2/WebP, unlit,
              specular-glossiness. The camera and settings as without --pbr; the `mitsuba`
              (independent) and `mitsuba-ld` (ldsampler) renderers share one reference, rendered
              as Cycles' below with the independent sampler.

@@ -10,14 +10,15 @@ materials on Mitsuba's `principled` BSDF, under wavepath's environment map and c
 convert() and mitsuba_scene() need the standard library only (tests/test_peers_pbr.py checks the
 mapping with plain python3); realize() turns the placeholders into Mitsuba objects: textures into
 `bitmap` plugins with float `data` (decoded with Pillow and NumPy, factors and channel selections
-baked in), look-at and rotation transforms into mi.ScalarTransform4f.
+baked in), look-at and rotation transforms into mi.ScalarTransform4f, texture transforms
+(KHR_texture_transform) into mi.ScalarTransform3f.
 
 Reading: .gltf (embedded or external buffers and images) and .glb, through peers_scene's reader;
-PNG and JPEG images. Refused (ConversionError naming it): KHR_texture_transform, a texCoord other
-than 0, KHR_draco_mesh_compression, EXT_meshopt_compression, KHR_mesh_quantization,
-EXT_mesh_gpu_instancing, KHR_texture_basisu, EXT_texture_webp, KHR_materials_unlit,
-KHR_materials_pbrSpecularGlossiness, any other extension the file requires, sparse accessors,
-primitives that are not triangles, cameras that are not perspective.
+PNG and JPEG images. Refused (ConversionError naming it): a texCoord other than 0 (a textureInfo's,
+or KHR_texture_transform's override of it), KHR_draco_mesh_compression, EXT_meshopt_compression,
+KHR_mesh_quantization, EXT_mesh_gpu_instancing, KHR_texture_basisu, EXT_texture_webp,
+KHR_materials_unlit, KHR_materials_pbrSpecularGlossiness, any other extension the file requires,
+sparse accessors, primitives that are not triangles, cameras that are not perspective.
 
 Geometry: every triangle primitive of the default scene becomes one binary PLY in world space
 (node transforms applied; normals by the inverse transpose; a mirroring transform reverses the
@@ -52,6 +53,8 @@ Material mapping (glTF -> Mitsuba `principled`; "tex" means the parameter become
       radiance (tex)
   sampler: magFilter NEAREST -> filter_type nearest, else bilinear; wrapS -> wrap_mode
       (REPEAT repeat, CLAMP_TO_EDGE clamp, MIRRORED_REPEAT mirror)
+  KHR_texture_transform (on any texture converted) offset, rotation, scale -> the bitmap's
+      to_uv = uv_transform() (exact: see there), each texture use its own
   KHR_lights_punctual point -> `point` (intensity x colour, W/sr); spot -> `spot` (cutoff_angle =
       outerConeAngle, beam_width = innerConeAngle); directional -> `directional` (irradiance
       W/m^2); each at its node's world transform, shining down the node's -Z
@@ -85,7 +88,6 @@ from wavepath_tools import peers_scene as ps
 from wavepath_tools.peers_scene import ConversionError
 
 REFUSED = {
-    "KHR_texture_transform": "texture transforms are not converted",
     "KHR_draco_mesh_compression": "compressed meshes are not decoded",
     "EXT_meshopt_compression": "compressed meshes are not decoded",
     "KHR_mesh_quantization": "quantized attributes are not read",
@@ -101,7 +103,7 @@ CONVERTED = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mate
              "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy",
              "KHR_materials_diffuse_transmission", "KHR_materials_iridescence",
              "KHR_materials_dispersion", "KHR_materials_variants", "KHR_xmp_json_ld",
-             "EXT_lights_image_based"}
+             "EXT_lights_image_based", "KHR_texture_transform"}
 
 NEAREST = 9728
 WRAP = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
@@ -180,6 +182,30 @@ def _image_files(doc, buffers, path, work):
     return out
 
 
+def uv_transform(xf):
+    """KHR_texture_transform `xf` as the row-major 3 x 3 matrix M (last row 0 0 1) that glTF
+    applies to a texture coordinate: it looks (u, v) up at M (u, v, 1). M = T(offset) R(rotation)
+    S(scale) has rows (c sx, s sy, ox), (-s sx, c sy, oy), c = cos(rotation), s = sin(rotation):
+    the UVs turn counter-clockwise, the image clockwise, as the extension's text and its example
+    (offset (0, 1), rotation pi/2, scale 0.5 selects the lower left quadrant) have it, and as
+    wavepath's loader (host/scene/gltf_textures.cpp) does. (The extension's GLSL listing, read as
+    GLSL's column-major constructor, turns the other way and contradicts that example.)
+
+    M is Mitsuba's bitmap to_uv as it is: to_uv maps the mesh's UV to the lookup UV (bitmap.cpp:
+    uv = to_uv @ si.uv); the PLY keeps glTF's (u, v) (write_ply) and the bitmap looks v = 0 up in
+    the data's row 0, the image's top, glTF's origin (texture_data keeps the rows). Neither side
+    flips v, so the conjugation F M F (F: v -> 1 - v) that a flipped convention would need is M
+    itself, and Mitsuba samples the texel glTF's transform names."""
+    ox, oy = (float(x) for x in xf.get("offset", (0.0, 0.0)))
+    sx, sy = (float(x) for x in xf.get("scale", (1.0, 1.0)))
+    r = float(xf.get("rotation", 0.0))
+    c, s = math.cos(r), math.sin(r)
+    return [[c * sx, s * sy, ox], [-s * sx, c * sy, oy], [0.0, 0.0, 1.0]]
+
+
+IDENTITY3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+
+
 class Textures:
     """Makes the bitmap placeholders of one document; collects the notes on their samplers."""
 
@@ -188,13 +214,16 @@ class Textures:
 
     def get(self, info, where, channels, srgb, factor, op=None, arg=None, filter_type=None):
         """A placeholder dict for textureInfo `info`: channels (0 R .. 3 A) of its image,
-        decoded from sRGB when `srgb`, times `factor` (one per channel), then `op`."""
-        if info.get("texCoord", 0) != 0:
+        decoded from sRGB when `srgb`, times `factor` (one per channel), then `op`; with
+        KHR_texture_transform, to_uv (a placeholder) is its matrix."""
+        xf = info.get("extensions", {}).get("KHR_texture_transform")
+        if xf is not None and "texCoord" in xf:  # the extension's override replaces texCoord
+            if xf["texCoord"] != 0:
+                raise ConversionError("%s: KHR_texture_transform texCoord %d (only TEXCOORD_0 "
+                                      "converts)" % (where, xf["texCoord"]))
+        elif info.get("texCoord", 0) != 0:
             raise ConversionError("%s: texCoord %d (only TEXCOORD_0 converts)"
                                   % (where, info["texCoord"]))
-        if "KHR_texture_transform" in info.get("extensions", {}):
-            raise ConversionError("%s: KHR_texture_transform: %s"
-                                  % (where, REFUSED["KHR_texture_transform"]))
         tex = self.doc["textures"][info["index"]]
         if "source" not in tex:
             raise ConversionError("%s: texture %d has no source image" % (where, info["index"]))
@@ -208,11 +237,14 @@ class Textures:
                                                                           sampler["minFilter"]))
         if filter_type is None:
             filter_type = "nearest" if sampler.get("magFilter") == NEAREST else "bilinear"
-        return {"type": "bitmap", "raw": True, "filter_type": filter_type,
-                "wrap_mode": WRAP.get(wrap_s, "repeat"),
-                "peers": {"image": self.images[tex["source"]], "channels": list(channels),
-                          "srgb": srgb, "factor": [float(f) for f in factor], "op": op,
-                          "arg": arg}}
+        out = {"type": "bitmap", "raw": True, "filter_type": filter_type,
+               "wrap_mode": WRAP.get(wrap_s, "repeat"),
+               "peers": {"image": self.images[tex["source"]], "channels": list(channels),
+                         "srgb": srgb, "factor": [float(f) for f in factor], "op": op,
+                         "arg": arg}}
+        if xf is not None and uv_transform(xf) != IDENTITY3:
+            out["to_uv"] = {"peers_to_uv": uv_transform(xf)}
+        return out
 
 
 def _value(x):
@@ -660,7 +692,7 @@ def texture_data(spec, cache):
 def realize(d, mi, cache=None):
     """A copy of dict `d` with the placeholders made Mitsuba's: {"peers": spec} bitmaps get
     their data, {"peers_look_at": [o, t, up]} and {"peers_rotate_y": degrees} become
-    mi.ScalarTransform4f."""
+    mi.ScalarTransform4f, {"peers_to_uv": 3 x 3 rows} (a bitmap's to_uv) mi.ScalarTransform3f."""
     cache = {} if cache is None else cache
     if isinstance(d, dict):
         if "peers_look_at" in d:
@@ -668,6 +700,8 @@ def realize(d, mi, cache=None):
             return mi.ScalarTransform4f().look_at(origin=o, target=t, up=up)
         if "peers_rotate_y" in d:
             return mi.ScalarTransform4f().rotate([0.0, 1.0, 0.0], d["peers_rotate_y"])
+        if "peers_to_uv" in d:
+            return mi.ScalarTransform3f(d["peers_to_uv"])
         out = {k: realize(v, mi, cache) for k, v in d.items() if k != "peers"}
         if "peers" in d:
             out["data"] = mi.TensorXf(texture_data(d["peers"], cache))
