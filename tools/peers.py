@@ -118,10 +118,10 @@ without a camera is rendered by both from a copy with wavepath's framing camera 
              attenuation, mipmaps, wrapT, file tangents, back faces of one-sided materials
              (black, not culled), spot falloff (linear in angle), light range: each that
              applies is logged and listed on the page. KHR_texture_transform -> the bitmap's
-             to_uv. Refused: texCoord 1, Draco, meshopt, quantized or sparse attributes, instancing, KTX2/WebP, unlit,
-             specular-glossiness. The camera and settings as without --pbr; the `mitsuba`
-             (independent) and `mitsuba-ld` (ldsampler) renderers share one reference, rendered
-             as Cycles' below with the independent sampler.
+             to_uv. Refused: texCoord 1, Draco, meshopt, quantized or sparse attributes,
+             instancing, KTX2/WebP, unlit, specular-glossiness. The camera and settings as
+             without --pbr; the `mitsuba` (independent) and `mitsuba-ld` (ldsampler) renderers
+             share one reference, rendered as Cycles' below with the independent sampler.
   Errors     The two do not render the same material model (Blender's Principled BSDF is not
              glTF's BRDF: exact dielectric Fresnel and albedo-scaled diffuse, F82 metals,
              MikkTSpace tangents), so each renderer's relMSE is measured against its own
