@@ -270,15 +270,7 @@ def write_page(a, entries):
                      os.path.relpath(x, REPO) if x.endswith(".hdr") else x for x in extra)
                      if extra else "its own camera and lamp", what))
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-    text = "\n".join(L) + "\n"
-    notes = peers.NOTES_MARK + "\n"
-    if os.path.exists(a.out):
-        with open(a.out) as f:
-            old = f.read()
-        if peers.NOTES_MARK in old:
-            notes = old[old.index(peers.NOTES_MARK):]
-    with open(a.out, "w") as f:
-        f.write(text + "\n" + notes)
+    peers._write_with_notes(a, L)  # the hand-written notes after peers.NOTES_MARK stay
     log("wrote %s" % a.out)
 
 
